@@ -1,0 +1,60 @@
+// The plug-in point between features and alarms. The worker builds one Observation per hop
+// (every `step` samples) for each actuator; a Detector turns the stream of observations into a
+// score that the alarm state machine (daemon/) compares with its raise/clear thresholds.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace leakmon::detect {
+
+inline constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
+
+// What one hop of an actuator's data says. Any field the configuration does not acquire, or
+// whose window held a gap, is NaN.
+struct Observation {
+  double t = kMissing;         // time of the sample that completed the window [s]
+  double index_p1 = kMissing;  // db8 level-2 detail RMS of p1 over the window [Pa]
+  double index_p2 = kMissing;  // the same for p2 [Pa]
+  // Means over the last hop (the `step` newest samples):
+  double u = kMissing;   // valve command [V]
+  double x = kMissing;   // position [m]
+  double p1 = kMissing;  // chamber pressures [Pa]
+  double p2 = kMissing;
+  // Standard deviation of the position reference or position over the window, when known: the
+  // excitation that produced the index.
+  double x_activity = kMissing;
+};
+
+struct Decision {
+  // Dimensionless evidence of a leak: the alarm raises when score >= raise_threshold() and
+  // clears when score <= clear_threshold(). NaN when the detector cannot judge this hop (still
+  // learning, or the observation had gaps): the alarm state then holds.
+  double score = kMissing;
+  bool learning = true;              // still learning the healthy baseline
+  double baseline = kMissing;        // learned healthy level of the index [Pa]
+  double index = kMissing;           // the index value this decision used [Pa]
+  // Estimated internal leakage coefficient C_L [m^3/(s Pa)] and its 95 % half-width; NaN when
+  // the detector cannot size the leak.
+  double leak_coefficient = kMissing;
+  double leak_coefficient_ci = kMissing;
+};
+
+class Detector {
+ public:
+  virtual ~Detector() = default;
+  virtual std::string_view name() const = 0;
+  // Called once per hop from the worker thread; must not block.
+  virtual Decision update(const Observation& observation) = 0;
+  // Thresholds on Decision::score that this detector was designed for; the alarm configuration
+  // may override them. clear_threshold() < raise_threshold() gives the deadband.
+  virtual double raise_threshold() const = 0;
+  virtual double clear_threshold() const = 0;
+  // Forget everything learned (e.g. after maintenance, on operator request).
+  virtual void reset() = 0;
+};
+
+}  // namespace leakmon::detect
