@@ -1,0 +1,88 @@
+#include "config/yaml_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <functional>
+
+#include "tests/support/paths.hpp"
+
+namespace leakmon::config {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ConfigNode, UnknownKeyNamesFileLineColumnAndAllowedKeys) {
+  auto root = ConfigNode::load_string("period_ms: 2\nperiode: 3\n", "demo.yaml");
+  std::string message = error_of([&] { root.expect_keys({"period_ms", "priority"}); });
+  EXPECT_EQ(message,
+            "demo.yaml:2:1: periode: unknown key 'periode' (allowed: period_ms, priority)");
+}
+
+TEST(ConfigNode, NestedPathAndRangeError) {
+  auto root = ConfigNode::load_string("loop:\n  groups:\n    - period_ms: -1\n", "c.yaml");
+  auto group = root.at("loop").at("groups").items().at(0);
+  std::string message = error_of([&] { group.get_double("period_ms", 0.1, 100.0); });
+  EXPECT_EQ(message, "c.yaml:3:18: loop.groups[0].period_ms: value -1 is out of range [0.1, 100]");
+}
+
+TEST(ConfigNode, WrongTypeSaysWhatWasExpected) {
+  auto root = ConfigNode::load_string("port: ninety\nenabled: maybe\nlist: [1, 2]\n", "x.yaml");
+  EXPECT_EQ(error_of([&] { root.get_int("port", 1, 65535); }),
+            "x.yaml:1:7: port: expected an integer, got 'ninety'");
+  EXPECT_EQ(error_of([&] { root.get_bool("enabled", false); }),
+            "x.yaml:2:10: enabled: expected true or false, got 'maybe'");
+  EXPECT_NE(error_of([&] { root.get_double("list"); }).find("expected a number"), std::string::npos);
+}
+
+TEST(ConfigNode, MissingRequiredKeyAndDefaults) {
+  auto root = ConfigNode::load_string("a: 1\n", "m.yaml");
+  EXPECT_NE(error_of([&] { root.get_string("name"); }).find("missing required key 'name'"),
+            std::string::npos);
+  EXPECT_EQ(root.get_double("b", 2.5, 0, 10), 2.5);
+  EXPECT_EQ(root.get_int("a", 7, 0, 10), 1);
+  EXPECT_EQ(root.get_choice("mode", {"x", "y"}, "y"), "y");
+}
+
+TEST(ConfigNode, ChoiceListsTheValidValues) {
+  auto root = ConfigNode::load_string("mode: sym\n", "m.yaml");
+  EXPECT_EQ(error_of([&] { root.get_choice("mode", {"symmetric", "zero"}, "symmetric"); }),
+            "m.yaml:1:7: mode: 'sym' is not one of: symmetric, zero");
+}
+
+TEST(ConfigNode, SyntaxErrorHasLocation) {
+  std::string message = error_of([] { ConfigNode::load_string("a: [1, 2\nb: 3\n", "bad.yaml"); });
+  EXPECT_EQ(message.rfind("bad.yaml:", 0), 0u) << message;
+  EXPECT_NE(message.find(':', 9), std::string::npos);
+}
+
+TEST(ConfigNode, MissingFileIsAnError) {
+  EXPECT_EQ(error_of([] { ConfigNode::load_file("/nonexistent/leakmon.yaml"); }),
+            "/nonexistent/leakmon.yaml: cannot open file");
+}
+
+TEST(ConfigNode, LoadsFromFileWithItsName) {
+  std::string dir = test::scratch_dir("ConfigNode_LoadsFromFile");
+  std::string path = dir + "/f.yaml";
+  std::ofstream(path) << "x: 1e-12\ny: +3\n";
+  auto root = ConfigNode::load_file(path);
+  EXPECT_DOUBLE_EQ(root.get_double("x"), 1e-12);
+  EXPECT_EQ(root.get_int("y", 0, 5), 3);
+  EXPECT_EQ(root.at("x").location(), path + ":1:4");
+}
+
+TEST(ConfigNode, NonFiniteNumbersRejected) {
+  auto root = ConfigNode::load_string("x: .inf\ny: nan\n", "n.yaml");
+  EXPECT_NE(error_of([&] { root.get_double("x"); }).find("finite"), std::string::npos);
+  EXPECT_NE(error_of([&] { root.get_double("y"); }).find("finite"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace leakmon::config
