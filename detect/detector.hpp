@@ -34,9 +34,9 @@ struct Decision {
   // clears when score <= clear_threshold(). NaN when the detector cannot judge this hop (still
   // learning, or the observation had gaps): the alarm state then holds.
   double score = kMissing;
-  bool learning = true;              // still learning the healthy baseline
-  double baseline = kMissing;        // learned healthy level of the index [Pa]
-  double index = kMissing;           // the index value this decision used [Pa]
+  bool learning = true;        // still learning the healthy baseline
+  double baseline = kMissing;  // learned healthy level of the index [Pa]
+  double index = kMissing;     // the index value this decision used [Pa]
   // Estimated internal leakage coefficient C_L [m^3/(s Pa)] and its 95 % half-width; NaN when
   // the detector cannot size the leak.
   double leak_coefficient = kMissing;

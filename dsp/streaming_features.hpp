@@ -49,6 +49,9 @@ class StreamingFeatures {
   void reset() noexcept;  // forget history (e.g. after a reload)
   const FeatureParams& params() const noexcept;
   std::size_t channels() const noexcept;
+  // True when updates reuse the previous window's interior coefficients (the step keeps the
+  // decimation phase of every level); false: each window is recomputed in full.
+  bool incremental() const noexcept;
 
  private:
   struct Engine;

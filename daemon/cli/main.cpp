@@ -17,7 +17,15 @@ struct Subcommand {
 };
 
 constexpr Subcommand kSubcommands[] = {
+    {"run", "run the leak monitoring daemon (--config CONFIG.yaml)", leakmon::cli::run_run},
+    {"replay", "feed a capture through the daemon's pipeline, write its events", leakmon::cli::run_replay},
+    {"check-config", "validate a daemon configuration without running it", leakmon::cli::run_check_config},
+    {"status", "summary from the running daemon", leakmon::cli::run_status},
+    {"ack", "acknowledge alarms in the running daemon", leakmon::cli::run_ack},
     {"features", "sliding-window wavelet index of one capture channel", leakmon::cli::run_features},
+    {"sim", "simulate the test rig (presets paper-fig10/13/16, scenario YAML)", leakmon::cli::run_sim},
+    {"evaluate", "Monte-Carlo error rates of the leak detectors", leakmon::cli::run_evaluate},
+    {"model", "model check: where the simulation disagrees with data, and why", leakmon::cli::run_model},
 };
 
 void print_help() {

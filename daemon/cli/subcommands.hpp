@@ -5,5 +5,13 @@
 namespace leakmon::cli {
 
 int run_features(int argc, char** argv);
+int run_model(int argc, char** argv);
+int run_sim(int argc, char** argv);
+int run_evaluate(int argc, char** argv);
+int run_run(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_check_config(int argc, char** argv);
+int run_status(int argc, char** argv);
+int run_ack(int argc, char** argv);
 
 }  // namespace leakmon::cli

@@ -1,0 +1,310 @@
+#include "daemon/config.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "daemon/sample.hpp"
+#include "detect/factory.hpp"
+#include "daemon/driver_registry.hpp"
+#include "daemon/output_registry.hpp"
+
+namespace leakmon::daemon {
+namespace {
+
+std::string checked_name(const config::ConfigNode& node, std::set<std::string>& seen,
+                         std::string_view what) {
+  const auto name_node = node.at("name");
+  const std::string name = name_node.as_string();
+  if (name.empty() || name.find_first_of(". \t/") != std::string::npos) {
+    name_node.fail(fmt::format("{} name '{}' must be non-empty, without '.', '/' or spaces", what,
+                               name));
+  }
+  if (!seen.insert(name).second) name_node.fail(fmt::format("duplicate {} name '{}'", what, name));
+  return name;
+}
+
+ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig& config) {
+  const std::string text = node.as_string();
+  const auto dot = text.find('.');
+  ChannelRef ref;
+  ref.where = node;
+  if (dot == std::string::npos) {
+    if (config.drivers.size() != 1) {
+      node.fail(fmt::format("'{}': name the driver as 'driver.channel' when there are several "
+                            "drivers",
+                            text));
+    }
+    ref.driver = config.drivers.front().name;
+    ref.channel = text;
+  } else {
+    ref.driver = text.substr(0, dot);
+    ref.channel = text.substr(dot + 1);
+  }
+  if (ref.channel.empty()) node.fail(fmt::format("'{}': empty channel name", text));
+  const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
+                                 [&](const DriverConfig& d) { return d.name == ref.driver; });
+  if (!known) node.fail(fmt::format("'{}': no driver named '{}'", text, ref.driver));
+  return ref;
+}
+
+dsp::FeatureParams parse_features(const config::ConfigNode& node) {
+  node.expect_keys({"wavelet", "level", "window", "step", "mode"});
+  dsp::FeatureParams params;
+  params.wavelet = node.get_string("wavelet", params.wavelet);
+  params.level = static_cast<int>(node.get_int("level", params.level, 1, 12));
+  params.window = static_cast<std::size_t>(
+      node.get_int("window", static_cast<long long>(params.window), 2, 1 << 20));
+  params.step = static_cast<std::size_t>(
+      node.get_int("step", static_cast<long long>(params.step), 1, 1 << 20));
+  if (auto mode = node.find("mode")) {
+    try {
+      params.mode = dsp::parse_mode(mode->as_string());
+    } catch (const std::invalid_argument& e) {
+      mode->fail(e.what());
+    }
+  }
+  try {
+    dsp::validate(params);
+  } catch (const std::invalid_argument& e) {
+    node.fail(e.what());
+  }
+  return params;
+}
+
+AlarmSettings parse_alarm(const config::ConfigNode& node) {
+  node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching"});
+  AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
+  if (node.has("raise")) alarm.raise_threshold = node.get_double("raise", -1e9, 1e9);
+  if (node.has("clear")) alarm.clear_threshold = node.get_double("clear", -1e9, 1e9);
+  if (!std::isnan(alarm.raise_threshold) && !std::isnan(alarm.clear_threshold) &&
+      alarm.clear_threshold >= alarm.raise_threshold) {
+    node.at("clear").fail(fmt::format("clear threshold {} must be below the raise threshold {} "
+                                      "(the deadband)",
+                                      alarm.clear_threshold, alarm.raise_threshold));
+  }
+  alarm.on_delay_s = node.get_double("on_delay_s", 0.0, 0.0, 86400.0);
+  alarm.off_delay_s = node.get_double("off_delay_s", 0.0, 0.0, 86400.0);
+  alarm.latching = node.get_bool("latching", false);
+  return alarm;
+}
+
+ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
+                              std::set<std::string>& names) {
+  node.expect_keys({"name", "channels", "features", "detector", "alarm"});
+  ActuatorConfig actuator;
+  actuator.name = checked_name(node, names, "actuator");
+  const auto channels = node.at("channels");
+  channels.expect_keys({"p1", "p2", "u", "x", "xref"});
+  actuator.p1 = parse_channel_ref(channels.at("p1"), config);
+  for (auto [role, ref] : {std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
+                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
+    if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
+  }
+  // One actuator's signals must be sampled together (one group, one clock).
+  const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
+  for (const auto* ref : {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+    if (ref->present() && group_of_driver(config, ref->driver) != group) {
+      channels.fail(fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
+                                "actuator's channels must come from one sampling group",
+                                ref->text(), actuator.p1.text()));
+    }
+  }
+  if (auto features = node.find("features")) actuator.features = parse_features(*features);
+  if (auto detector = node.find("detector")) {
+    if (detector->is_scalar()) {
+      actuator.detector = detector->as_string();
+    } else {
+      detector->expect_keys({"kind", "options"});
+      actuator.detector = detector->get_string("kind", "default");
+      actuator.detector_options = detector->find("options");
+    }
+    const auto kinds = detect::detector_kinds();
+    if (std::find(kinds.begin(), kinds.end(), actuator.detector) == kinds.end()) {
+      detector->fail(fmt::format("unknown detector '{}' (known: {})", actuator.detector,
+                                 fmt::join(kinds, ", ")));
+    }
+  }
+  if (auto alarm = node.find("alarm")) {
+    actuator.alarm = parse_alarm(*alarm);
+    actuator.alarm_name = alarm->get_string("name", actuator.alarm_name);
+  }
+  return actuator;
+}
+
+GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& config,
+                        std::set<std::string>& names, std::set<std::string>& grouped) {
+  node.expect_keys({"name", "period_ms", "drivers", "priority", "cpus", "ring_capacity"});
+  GroupConfig group;
+  group.name = checked_name(node, names, "sampling group");
+  group.period_ns = static_cast<std::int64_t>(
+      std::llround(node.get_double("period_ms", 2.0, 0.05, 10000.0) * 1e6));
+  group.priority = static_cast<int>(node.get_int("priority", group.priority, 0, 99));
+  group.ring_capacity = static_cast<std::size_t>(
+      node.get_int("ring_capacity", static_cast<long long>(group.ring_capacity), 16, 1 << 22));
+  if (auto cpus = node.find("cpus")) {
+    for (const auto& cpu : cpus->items()) {
+      group.cpus.push_back(static_cast<int>(cpu.check_range(static_cast<double>(cpu.as_int()), 0,
+                                                            1023)));
+    }
+  }
+  for (const auto& item : node.at("drivers").items()) {
+    const std::string name = item.as_string();
+    const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
+                                   [&](const DriverConfig& d) { return d.name == name; });
+    if (!known) item.fail(fmt::format("no driver named '{}'", name));
+    if (!grouped.insert(name).second) {
+      item.fail(fmt::format("driver '{}' is already in another sampling group", name));
+    }
+    group.drivers.push_back(name);
+  }
+  if (group.drivers.empty()) node.at("drivers").fail("a sampling group needs at least one driver");
+  return group;
+}
+
+}  // namespace
+
+const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver) {
+  for (const auto& group : config.groups) {
+    if (std::find(group.drivers.begin(), group.drivers.end(), driver) != group.drivers.end()) {
+      return &group;
+    }
+  }
+  return nullptr;
+}
+
+DaemonConfig parse_config(const config::ConfigNode& root) {
+  root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "metrics",
+                    "outputs"});
+  DaemonConfig config;
+  config.source = root.source();
+
+  std::set<std::string> driver_names;
+  const auto drivers = root.at("drivers");
+  for (const auto& node : drivers.items()) {
+    DriverConfig driver;
+    driver.name = checked_name(node, driver_names, "driver");
+    driver.type = node.get_string("type");
+    driver.node = node;
+    config.drivers.push_back(std::move(driver));
+  }
+  if (config.drivers.empty()) drivers.fail("at least one driver is needed");
+
+  if (auto sampling = root.find("sampling")) {
+    std::set<std::string> group_names, grouped;
+    for (const auto& node : sampling->items()) {
+      config.groups.push_back(parse_group(node, config, group_names, grouped));
+    }
+    for (const auto& driver : config.drivers) {
+      if (!grouped.count(driver.name)) {
+        sampling->fail(fmt::format("driver '{}' is in no sampling group", driver.name));
+      }
+    }
+  } else {
+    GroupConfig group;
+    for (const auto& driver : config.drivers) group.drivers.push_back(driver.name);
+    config.groups.push_back(group);
+  }
+
+  std::set<std::string> actuator_names;
+  const auto actuators = root.at("actuators");
+  for (const auto& node : actuators.items()) {
+    config.actuators.push_back(parse_actuator(node, config, actuator_names));
+  }
+  if (config.actuators.empty()) actuators.fail("at least one actuator is needed");
+
+  if (auto events = root.find("events")) {
+    events->expect_keys({"log"});
+    config.event_log = events->get_string("log", "");
+  }
+  if (auto recording = root.find("recording")) {
+    recording->expect_keys({"directory", "rotate_seconds", "keep_files", "flush_seconds"});
+    config.recording.directory = recording->get_string("directory");
+    config.recording.rotate_seconds = recording->get_double("rotate_seconds", 3600.0, 1.0, 1e7);
+    config.recording.keep_files =
+        static_cast<std::size_t>(recording->get_int("keep_files", 24, 0, 1000000));
+    config.recording.flush_seconds = recording->get_double("flush_seconds", 1.0, 0.01, 1.0);
+  }
+  if (auto metrics = root.find("metrics")) {
+    metrics->expect_keys({"address", "port"});
+    config.metrics.address = metrics->get_string("address", config.metrics.address);
+    config.metrics.port = static_cast<int>(metrics->get_int("port", config.metrics.port, 0, 65535));
+  }
+  if (auto outputs = root.find("outputs")) {
+    std::set<std::string> output_names;
+    for (const auto& node : outputs->items()) {
+      checked_name(node, output_names, "output");
+      node.get_string("type");
+      config.outputs.push_back(node);
+    }
+  }
+  return config;
+}
+
+DaemonConfig load_config(const std::string& path) {
+  return parse_config(config::ConfigNode::load_file(path));
+}
+
+void check_channels(const DaemonConfig& config,
+                    const std::vector<std::vector<std::string>>& driver_channels) {
+  auto channels_of = [&](const std::string& driver) -> const std::vector<std::string>& {
+    for (std::size_t i = 0; i < config.drivers.size(); ++i) {
+      if (config.drivers[i].name == driver) return driver_channels.at(i);
+    }
+    throw std::logic_error("unknown driver " + driver);
+  };
+  for (const auto& group : config.groups) {
+    std::size_t count = 0;
+    for (const auto& driver : group.drivers) count += channels_of(driver).size();
+    if (count > kMaxGroupChannels) {
+      throw config::ConfigError(fmt::format("{}: sampling group '{}' has {} channels; at most {}",
+                                            config.source, group.name, count, kMaxGroupChannels));
+    }
+  }
+  for (const auto& actuator : config.actuators) {
+    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+      if (!ref->present()) continue;
+      const auto& names = channels_of(ref->driver);
+      if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;
+      const std::string message =
+          fmt::format("driver '{}' has no channel '{}' (it has: {})", ref->driver, ref->channel,
+                      fmt::join(names, ", "));
+      if (ref->where) ref->where->fail(message);
+      throw config::ConfigError(fmt::format("{}: {}", config.source, message));
+    }
+    // Build the detector once so that its options and signal needs are checked now.
+    const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
+    detect::AvailableSignals signals;
+    signals.p1 = true;
+    signals.p2 = actuator.p2.present();
+    signals.u = actuator.u.present();
+    signals.x = actuator.x.present();
+    const double hop_seconds = static_cast<double>(actuator.features.step) *
+                               static_cast<double>(group ? group->period_ns : 2'000'000) / 1e9;
+    try {
+      detect::make_detector(actuator.detector, signals, hop_seconds,
+                            actuator.detector_options ? &*actuator.detector_options : nullptr);
+    } catch (const std::invalid_argument& e) {
+      throw config::ConfigError(
+          fmt::format("{}: actuator '{}': {}", config.source, actuator.name, e.what()));
+    }
+  }
+}
+
+DaemonConfig check_config(const std::string& path) {
+  DaemonConfig config = load_config(path);
+  std::vector<std::vector<std::string>> driver_channels;
+  for (const auto& driver : config.drivers) {
+    auto built = make_driver(*driver.node);
+    const auto names = built->channels();
+    driver_channels.emplace_back(names.begin(), names.end());
+  }
+  check_channels(config, driver_channels);
+  for (const auto& node : config.outputs) make_output(node);
+  return config;
+}
+
+}  // namespace leakmon::daemon

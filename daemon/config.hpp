@@ -1,0 +1,99 @@
+// The daemon's configuration (schema: config/README.md), read from YAML with errors that name
+// file, line and column. Everything is validated when loaded, so that `check-config`, start-up
+// and SIGHUP reload reject the same mistakes before anything runs.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/yaml_reader.hpp"
+#include "daemon/alarm.hpp"
+#include "dsp/streaming_features.hpp"
+
+namespace leakmon::daemon {
+
+// A `drivers:` entry; the mapping is handed whole to the driver's factory.
+struct DriverConfig {
+  std::string name;
+  std::string type;
+  std::optional<config::ConfigNode> node;  // absent for drivers built in code (replay_capture)
+};
+
+// A `sampling:` group: one real-time thread, one ring buffer.
+struct GroupConfig {
+  std::string name = "main";
+  std::int64_t period_ns = 2'000'000;
+  std::vector<std::string> drivers;  // names from `drivers:`
+  int priority = 80;                 // SCHED_FIFO priority; 0 keeps normal scheduling
+  std::vector<int> cpus;             // CPU affinity; empty = any
+  std::size_t ring_capacity = 8192;  // samples (16 s at 500 Hz)
+};
+
+// Where one actuator signal comes from: `driver.channel`.
+struct ChannelRef {
+  std::string driver;
+  std::string channel;
+  std::optional<config::ConfigNode> where;  // the YAML scalar, for error locations
+  bool present() const { return !channel.empty(); }
+  std::string text() const { return driver.empty() ? channel : driver + "." + channel; }
+};
+
+struct ActuatorConfig {
+  std::string name;
+  // Signals by role; p1 is required, the others optional (MODEL.md names).
+  ChannelRef p1, p2, u, x, xref;
+  dsp::FeatureParams features;
+  std::string detector = "default";
+  std::optional<config::ConfigNode> detector_options;
+  // Thresholds left NaN take the detector's own.
+  AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
+  std::string alarm_name = "internal_leakage";
+};
+
+struct RecordingConfig {
+  std::string directory;            // empty: no recording
+  double rotate_seconds = 3600.0;   // start a new file after this much source time
+  std::size_t keep_files = 24;      // oldest files beyond this are deleted; 0 keeps all
+  double flush_seconds = 1.0;
+};
+
+struct MetricsConfig {
+  std::string address = "127.0.0.1";
+  int port = 9187;  // 0 disables the metrics and control endpoint
+};
+
+struct DaemonConfig {
+  std::string source;  // file the configuration came from, for messages
+  std::vector<DriverConfig> drivers;
+  std::vector<GroupConfig> groups;
+  std::vector<ActuatorConfig> actuators;
+  std::string event_log;  // JSON-lines file; empty: none
+  RecordingConfig recording;
+  MetricsConfig metrics;
+  std::vector<config::ConfigNode> outputs;
+  // Worker wake-up interval when the rings are empty [ns].
+  std::int64_t worker_poll_ns = 2'000'000;
+};
+
+// Parses and validates; throws config::ConfigError with `file:line:column: path: message`.
+// Does not construct drivers (check_config() does that too, without starting them).
+DaemonConfig parse_config(const config::ConfigNode& root);
+DaemonConfig load_config(const std::string& path);
+
+// Full validation as `leakmon check-config` does it: parse, then build (not start) every
+// driver, output and detector so their own option checks run, and check that every actuator
+// channel exists. Throws ConfigError.
+DaemonConfig check_config(const std::string& path);
+
+// Checks actuator channel references and group sizes against the channels the built drivers
+// offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.
+void check_channels(const DaemonConfig& config,
+                    const std::vector<std::vector<std::string>>& driver_channels);
+
+// The group that holds `driver`, or nullptr.
+const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);
+
+}  // namespace leakmon::daemon

@@ -1,0 +1,94 @@
+// `leakmon run`: the service. Builds the pipeline from the configuration (drivers -> one
+// acquisition loop thread and ring per sampling group -> worker thread -> sinks), serves
+// metrics and control on 127.0.0.1, talks sd_notify, and handles signals on the main thread:
+// SIGHUP reloads (an invalid configuration keeps the running one), SIGTERM/SIGINT stop cleanly
+// (acquisition stops, the rings drain, events and captures are flushed). When every source is
+// finite (replay without loop) and has ended, the daemon drains and exits as if stopped.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/acquisition_loop.hpp"
+#include "daemon/config.hpp"
+#include "daemon/event.hpp"
+#include "daemon/http_endpoint.hpp"
+#include "daemon/service_notifier.hpp"
+#include "daemon/worker.hpp"
+#include "io/driver.hpp"
+
+namespace leakmon::daemon {
+
+class Daemon {
+ public:
+  explicit Daemon(std::string config_path);
+  ~Daemon();
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+
+  // Runs until SIGTERM/SIGINT (or the end of every finite source). Returns the exit code.
+  // Throws config::ConfigError / io::DriverError when the configuration cannot start.
+  int run();
+
+  // Prometheus text exposition of everything the daemon counts.
+  std::string metrics_text() const;
+  // The human summary `leakmon status` prints.
+  std::string status_text() const;
+
+ private:
+  struct Group {
+    GroupConfig config;
+    std::vector<io::Driver*> drivers;
+    std::unique_ptr<SpscRing<Sample>> ring;
+    std::unique_ptr<AcquisitionLoop> loop;
+    std::thread thread;
+    RealtimeReport realtime;
+    std::atomic<bool> realtime_ready{false};
+  };
+  struct DriverWatch {
+    std::string state = "ok";
+    std::uint64_t errors = 0;
+  };
+
+  void start();
+  void stop();
+  std::vector<std::unique_ptr<EventSink>> build_sinks(const DaemonConfig& config) const;
+  static std::vector<EventSink*> raw(const std::vector<std::unique_ptr<EventSink>>& sinks);
+  void reload();
+  void housekeeping(std::int64_t now_ns);
+  bool making_progress(std::int64_t now_ns);
+  bool all_sources_ended() const;
+  HttpResponse handle(const HttpRequest& request);
+
+  std::string config_path_;
+  DaemonConfig config_;
+  std::vector<std::unique_ptr<io::Driver>> drivers_;
+  std::vector<std::unique_ptr<Group>> groups_;
+  std::vector<std::unique_ptr<EventSink>> sinks_;
+  std::unique_ptr<Worker> worker_;
+  std::thread worker_thread_;
+  std::unique_ptr<HttpEndpoint> endpoint_;
+  ServiceNotifier notifier_;
+  std::atomic<bool> stop_acquisition_{false};
+  std::atomic<bool> stop_worker_{false};
+
+  // Housekeeping state (main thread only).
+  std::vector<std::uint64_t> reported_overruns_;
+  std::vector<DriverWatch> driver_watch_;
+  std::int64_t last_overrun_warning_ns_ = 0;
+  std::int64_t last_watchdog_ns_ = 0;
+  std::uint64_t last_processed_ = 0;
+  std::int64_t started_ns_ = 0;
+
+  // Read by the metrics thread.
+  std::atomic<std::uint64_t> reloads_{0};
+  std::atomic<std::uint64_t> reload_failures_{0};
+  std::atomic<bool> last_reload_ok_{true};
+  std::atomic<std::int64_t> last_reload_unix_{0};
+};
+
+}  // namespace leakmon::daemon

@@ -1,0 +1,148 @@
+#include "daemon/event_log.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace leakmon::daemon {
+namespace {
+
+void append_json_string(std::string& out, std::string_view text) {
+  out += '"';
+  for (char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+
+class JsonObject {
+ public:
+  void string(std::string_view key, std::string_view value) {
+    if (value.empty()) return;
+    key_(key);
+    append_json_string(text_, value);
+  }
+  void number(std::string_view key, double value) {
+    if (!std::isfinite(value)) return;
+    key_(key);
+    text_ += fmt::format("{}", value);
+  }
+  void boolean(std::string_view key, bool value) {
+    key_(key);
+    text_ += value ? "true" : "false";
+  }
+  std::string finish() { return text_ + "}"; }
+
+ private:
+  void key_(std::string_view key) {
+    text_ += text_.size() > 1 ? ", " : "";
+    append_json_string(text_, key);
+    text_ += ": ";
+  }
+  std::string text_ = "{";
+};
+
+bool is_alarm(EventKind kind) {
+  return kind == EventKind::alarm_raised || kind == EventKind::alarm_cleared ||
+         kind == EventKind::alarm_acknowledged;
+}
+
+}  // namespace
+
+std::string to_json_line(const Event& event) {
+  JsonObject json;
+  json.number("t", event.t);
+  json.string("event", to_string(event.kind));
+  json.string("actuator", event.actuator);
+  json.string("alarm", event.alarm);
+  json.string("channel", event.channel);
+  json.number("index", event.index / 1e3);
+  json.number("score", event.score);
+  json.number("baseline", event.baseline / 1e3);
+  json.number("leak_coefficient", event.leak_coefficient);
+  json.number("leak_lpm_per_mpa", event.leak_lpm_per_mpa);
+  json.number("leak_lpm", event.leak_lpm);
+  json.number("load_pressure_mpa", event.load_pressure / 1e6);
+  if (is_alarm(event.kind)) json.boolean("latched", event.latched);
+  json.string("message", event.message);
+  return json.finish();
+}
+
+std::string to_log_line(const Event& event) {
+  std::string line(to_string(event.kind));
+  if (!event.actuator.empty()) line += fmt::format(" actuator={}", event.actuator);
+  if (!event.alarm.empty()) line += fmt::format(" alarm={}", event.alarm);
+  if (!event.channel.empty()) line += fmt::format(" channel={}", event.channel);
+  if (std::isfinite(event.t)) line += fmt::format(" t={:.3f}s", event.t);
+  if (std::isfinite(event.index)) line += fmt::format(" index={:.2f}kPa", event.index / 1e3);
+  if (std::isfinite(event.baseline)) {
+    line += fmt::format(" baseline={:.2f}kPa", event.baseline / 1e3);
+  }
+  if (std::isfinite(event.leak_lpm_per_mpa)) {
+    line += fmt::format(" leak={:.3f}l/min/MPa", event.leak_lpm_per_mpa);
+  }
+  if (std::isfinite(event.leak_lpm)) line += fmt::format(" ({:.3f}l/min at load)", event.leak_lpm);
+  if (!event.message.empty()) line += fmt::format(": {}", event.message);
+  return line;
+}
+
+JsonlEventLog::JsonlEventLog(const std::string& path) : path_(path) {
+  const auto parent = std::filesystem::path(path).parent_path();
+  std::error_code ignored;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
+  file_ = std::fopen(path.c_str(), "a");
+  if (file_ == nullptr) {
+    throw std::runtime_error(
+        fmt::format("{}: cannot open event log: {}", path, std::strerror(errno)));
+  }
+}
+
+JsonlEventLog::~JsonlEventLog() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+void JsonlEventLog::publish(const Event& event) {
+  const std::string line = to_json_line(event) + "\n";
+  std::fwrite(line.data(), 1, line.size(), file_);
+  std::fflush(file_);
+}
+
+void JsonlEventLog::flush() { std::fflush(file_); }
+
+void LogEventSink::publish(const Event& event) {
+  const auto level = (event.kind == EventKind::alarm_raised ||
+                      event.kind == EventKind::driver_fault || event.kind == EventKind::overrun ||
+                      event.kind == EventKind::config_rejected)
+                         ? spdlog::level::warn
+                         : spdlog::level::info;
+  spdlog::log(level, "{}", to_log_line(event));
+}
+
+std::unique_ptr<EventSink> make_jsonl_output(const config::ConfigNode& node) {
+  node.expect_keys({"name", "type", "path"});
+  const auto path = node.at("path");
+  try {
+    return std::make_unique<JsonlEventLog>(path.as_string());
+  } catch (const std::runtime_error& e) {
+    path.fail(e.what());
+  }
+}
+
+}  // namespace leakmon::daemon

@@ -1,0 +1,173 @@
+#include "daemon/worker.hpp"
+
+#include <algorithm>
+
+#include "daemon/acquisition_loop.hpp"
+
+namespace leakmon::daemon {
+
+ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<ChannelRef>& channels) {
+  auto find = [&](const ChannelRef& ref) {
+    if (!ref.present()) return -1;
+    for (std::size_t i = 0; i < channels.size(); ++i) {
+      if (channels[i].driver == ref.driver && channels[i].channel == ref.channel) {
+        return static_cast<int>(i);
+      }
+    }
+    return -1;
+  };
+  return ChannelLayout{find(actuator.p1), find(actuator.p2), find(actuator.u), find(actuator.x),
+                       find(actuator.xref)};
+}
+
+Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
+               std::vector<EventSink*> sinks)
+    : sinks_(std::move(sinks)) {
+  for (auto& input : groups) {
+    GroupState group;
+    group.input = std::move(input);
+    build_monitors(config, group, nullptr);
+    if (!config.recording.directory.empty()) {
+      // One driver: plain channel names, so `leakmon replay` finds p1, p2, u, x by default.
+      const bool one_driver = std::all_of(
+          group.input.channels.begin(), group.input.channels.end(),
+          [&](const ChannelRef& c) { return c.driver == group.input.channels.front().driver; });
+      std::vector<std::string> columns;
+      for (const auto& c : group.input.channels) columns.push_back(one_driver ? c.channel : c.text());
+      group.recorder = std::make_unique<CaptureRecorder>(
+          group.input.name, columns, 1e9 / static_cast<double>(group.input.period_ns),
+          config.recording);
+    }
+    groups_.push_back(std::move(group));
+  }
+}
+
+Worker::~Worker() { flush(); }
+
+void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
+                            std::vector<std::unique_ptr<ActuatorMonitor>>* previous) {
+  std::vector<std::unique_ptr<ActuatorMonitor>> monitors;
+  for (const auto& actuator : config.actuators) {
+    const ChannelLayout layout = layout_of(actuator, group.input.channels);
+    if (layout.p1 < 0) continue;  // another group's actuator
+    std::unique_ptr<ActuatorMonitor> kept;
+    if (previous != nullptr) {
+      for (auto& old : *previous) {
+        if (old && old->name() == actuator.name && old->same_pipeline(actuator, layout)) {
+          kept = std::move(old);
+          kept->set_alarm_settings(actuator.alarm);
+          break;
+        }
+      }
+    }
+    monitors.push_back(kept ? std::move(kept)
+                            : std::make_unique<ActuatorMonitor>(actuator, layout,
+                                                                group.input.period_ns));
+  }
+  group.monitors = std::move(monitors);
+}
+
+std::size_t Worker::drain(std::int64_t now_ns) {
+  std::lock_guard lock(mutex_);
+  std::size_t processed = 0;
+  for (auto& group : groups_) {
+    while (Sample* sample = group.input.ring->front()) {
+      process(group, *sample, now_ns);
+      group.input.ring->pop();
+      ++processed;
+    }
+    if (group.recorder) group.recorder->maybe_flush(now_ns);
+  }
+  samples_ += processed;
+  return processed;
+}
+
+void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_ns) {
+  const EventPublisher publish = [this](const Event& event) { publish_locked(event); };
+  // Ticks that never arrived (missed cycles, ring drops) are gaps: they must invalidate the
+  // windows that span them, not silently splice the signal together.
+  if (group.started && sample.tick > group.next_tick) {
+    const std::uint64_t missing = sample.tick - group.next_tick;
+    const double period_s = static_cast<double>(group.input.period_ns) / 1e9;
+    for (auto& monitor : group.monitors) {
+      const std::uint64_t feed =
+          std::min<std::uint64_t>(missing, monitor->config().features.window +
+                                               monitor->config().features.step);
+      for (std::uint64_t k = feed; k > 0; --k) {
+        monitor->push_gap(sample.t - static_cast<double>(k) * period_s, publish);
+      }
+    }
+  }
+  group.started = true;
+  group.next_tick = sample.tick + 1;
+
+  if (group.recorder) group.recorder->record(sample);
+  bool decided = false;
+  for (auto& monitor : group.monitors) decided |= monitor->push(sample, publish);
+  if (decided && sample.monotonic_ns > 0) {
+    decision_latency_.record(monotonic_now_ns() - sample.monotonic_ns);
+  }
+  (void)now_ns;
+}
+
+void Worker::publish_locked(const Event& event) {
+  ++events_;
+  for (auto* sink : sinks_) sink->publish(event);
+}
+
+void Worker::publish(const Event& event) {
+  std::lock_guard lock(mutex_);
+  publish_locked(event);
+}
+
+std::size_t Worker::acknowledge(const std::string& actuator) {
+  std::lock_guard lock(mutex_);
+  const EventPublisher publish = [this](const Event& event) { publish_locked(event); };
+  std::size_t matched = 0;
+  for (auto& group : groups_) {
+    for (auto& monitor : group.monitors) {
+      if (!actuator.empty() && monitor->name() != actuator) continue;
+      monitor->acknowledge(publish);
+      ++matched;
+    }
+  }
+  return matched;
+}
+
+void Worker::apply(const DaemonConfig& config, std::vector<EventSink*> sinks) {
+  std::lock_guard lock(mutex_);
+  for (auto& group : groups_) {
+    auto previous = std::move(group.monitors);
+    build_monitors(config, group, &previous);
+  }
+  sinks_ = std::move(sinks);
+}
+
+void Worker::flush() {
+  std::lock_guard lock(mutex_);
+  for (auto& group : groups_) {
+    if (group.recorder) group.recorder->flush();
+  }
+  for (auto* sink : sinks_) sink->flush();
+}
+
+std::vector<ActuatorStatus> Worker::status() const {
+  std::lock_guard lock(mutex_);
+  std::vector<ActuatorStatus> result;
+  for (const auto& group : groups_) {
+    for (const auto& monitor : group.monitors) result.push_back(monitor->status());
+  }
+  return result;
+}
+
+std::uint64_t Worker::samples_processed() const {
+  std::lock_guard lock(mutex_);
+  return samples_;
+}
+
+std::uint64_t Worker::events_published() const {
+  std::lock_guard lock(mutex_);
+  return events_;
+}
+
+}  // namespace leakmon::daemon

@@ -1,0 +1,154 @@
+#include "detect/factory.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "detect/flow_balance_detector.hpp"
+#include "detect/fused_detector.hpp"
+#include "detect/index_cusum_detector.hpp"
+#include "detect/paper_baseline_detector.hpp"
+
+namespace leakmon::detect {
+
+namespace {
+
+constexpr double kMaxSeconds = 86400.0;
+
+bool has_pressure(const AvailableSignals& s) { return s.p1 || s.p2; }
+bool has_all(const AvailableSignals& s) { return s.p1 && s.p2 && s.u && s.x; }
+
+// Reads an optional double option into `value`, range-checked at the option's location.
+void read(const config::ConfigNode* options, std::string_view key, double& value, double lo,
+          double hi) {
+  if (options != nullptr) value = options->get_double(key, value, lo, hi);
+}
+
+void read_learning(const config::ConfigNode* options, LearningSchedule& learning) {
+  read(options, "settle_seconds", learning.settle_seconds, 0.0, kMaxSeconds);
+  read(options, "learn_seconds", learning.learn_seconds, 1.0, kMaxSeconds);
+}
+
+const std::vector<std::string> kLearningKeys = {"settle_seconds", "learn_seconds"};
+const std::vector<std::string> kIndexKeys = {"design_drop", "false_alarms_per_hour",
+                                             "block_seconds", "supply_pressure"};
+const std::vector<std::string> kFlowKeys = {"supply_pressure",
+                                            "tank_pressure",
+                                            "command_full_scale",
+                                            "valve_coefficient",
+                                            "valve_coefficient_uncertainty",
+                                            "piston_area",
+                                            "rest_speed",
+                                            "design_leak",
+                                            "false_alarms_per_hour",
+                                            "block_seconds",
+                                            "sizing_seconds"};
+const std::vector<std::string> kPaperKeys = {"baseline_quantile", "window_seconds",
+                                             "raise_fraction", "clear_fraction", "channel"};
+
+void expect_keys(const config::ConfigNode* options,
+                 std::initializer_list<const std::vector<std::string>*> groups) {
+  if (options == nullptr) return;
+  std::vector<std::string> allowed;
+  for (const auto* group : groups) allowed.insert(allowed.end(), group->begin(), group->end());
+  options->expect_keys(allowed);
+}
+
+IndexCusumOptions index_options(const config::ConfigNode* options, const AvailableSignals& s,
+                                double false_alarm_share) {
+  IndexCusumOptions o;
+  read_learning(options, o.learning);
+  read(options, "design_drop", o.design_drop, 0.005, 0.9);
+  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
+  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
+  read(options, "supply_pressure", o.supply_pressure, 1e5, 1e9);
+  o.false_alarms_per_hour *= false_alarm_share;
+  o.use_p1 = s.p1;
+  o.use_p2 = s.p2;
+  return o;
+}
+
+FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {
+  FlowBalanceOptions o;
+  read_learning(options, o.learning);
+  read(options, "supply_pressure", o.valve.supply_pressure, 1e5, 1e9);
+  read(options, "tank_pressure", o.valve.tank_pressure, 0.0, 1e8);
+  read(options, "command_full_scale", o.valve.command_full_scale, 1e-3, 1e3);
+  read(options, "valve_coefficient", o.valve_coefficient, 1e-12, 1.0);
+  read(options, "valve_coefficient_uncertainty", o.valve_coefficient_uncertainty, 0.0, 1.0);
+  read(options, "piston_area", o.piston_area, 1e-8, 10.0);
+  read(options, "rest_speed", o.rest_speed, 1e-6, 10.0);
+  read(options, "design_leak", o.design_leak, 1e-16, 1e-8);
+  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
+  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
+  read(options, "sizing_seconds", o.sizing_seconds, 1.0, kMaxSeconds);
+  o.false_alarms_per_hour *= false_alarm_share;
+  return o;
+}
+
+PaperBaselineOptions paper_options(const config::ConfigNode* options, const AvailableSignals& s) {
+  PaperBaselineOptions o;
+  read_learning(options, o.learning);
+  read(options, "baseline_quantile", o.baseline_quantile, 0.0, 1.0);
+  read(options, "window_seconds", o.window_seconds, 0.01, kMaxSeconds);
+  read(options, "raise_fraction", o.raise_fraction, 0.0, 1.0);
+  read(options, "clear_fraction", o.clear_fraction, 0.0, 1.0);
+  o.use_p2 = !s.p1;
+  if (options != nullptr) {
+    o.use_p2 = options->get_choice("channel", {"p1", "p2"}, s.p1 ? "p1" : "p2") == "p2";
+    if (o.clear_fraction >= o.raise_fraction) {
+      options->at("clear_fraction").fail("clear_fraction must be below raise_fraction");
+    }
+  }
+  return o;
+}
+
+void require(bool ok, const std::string& kind, const char* what) {
+  if (!ok) throw std::invalid_argument("detector '" + kind + "' needs " + what);
+}
+
+}  // namespace
+
+std::vector<std::string> detector_kinds() {
+  return {"default", "paper", "index_cusum", "flow_balance", "fused"};
+}
+
+std::string default_detector_kind(const AvailableSignals& signals) {
+  return has_all(signals) ? "fused" : "index_cusum";
+}
+
+std::unique_ptr<Detector> make_detector(const std::string& kind, const AvailableSignals& signals,
+                                        double hop_seconds, const config::ConfigNode* options) {
+  if (!(hop_seconds > 0.0)) throw std::invalid_argument("detector hop must be positive");
+  const std::string resolved = kind == "default" ? default_detector_kind(signals) : kind;
+  if (resolved == "paper") {
+    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
+    expect_keys(options, {&kLearningKeys, &kPaperKeys});
+    return std::make_unique<PaperBaselineDetector>(paper_options(options, signals), hop_seconds);
+  }
+  if (resolved == "index_cusum") {
+    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
+    expect_keys(options, {&kLearningKeys, &kIndexKeys});
+    return std::make_unique<IndexCusumDetector>(index_options(options, signals, 1.0), hop_seconds);
+  }
+  if (resolved == "flow_balance") {
+    require(has_all(signals), kind, "p1, p2, u and x");
+    expect_keys(options, {&kLearningKeys, &kFlowKeys});
+    return std::make_unique<FlowBalanceDetector>(flow_options(options, 1.0), hop_seconds);
+  }
+  if (resolved == "fused") {
+    require(has_all(signals), kind, "p1, p2, u and x");
+    expect_keys(options, {&kLearningKeys, &kIndexKeys, &kFlowKeys});
+    std::vector<std::unique_ptr<Detector>> members;
+    // Flow balance first: it is the one that sizes the leak.
+    members.push_back(
+        std::make_unique<FlowBalanceDetector>(flow_options(options, 0.5), hop_seconds));
+    members.push_back(
+        std::make_unique<IndexCusumDetector>(index_options(options, signals, 0.5), hop_seconds));
+    return std::make_unique<FusedDetector>(std::move(members));
+  }
+  std::string known;
+  for (const auto& k : detector_kinds()) known += (known.empty() ? "" : ", ") + k;
+  throw std::invalid_argument("unknown detector kind '" + kind + "' (known: " + known + ")");
+}
+
+}  // namespace leakmon::detect

@@ -1,0 +1,91 @@
+// Model-aware leak detector for configurations that acquire the command u and position x as
+// well as both chamber pressures. At rest the valve must deliver what leaks across the piston:
+// Kv * q(u, p1, p2) = C_L (p1 - p2) + (null leakage, bias), with q the orifice law
+// (valve_flow.hpp). During learning the healthy relation q = a + s0 (p1 - p2) + g sign(p1 - p2)
+// is fitted (the slope s0 is the valve's own null leakage, the intercept a bias, the sign term a
+// spool overlap); afterwards the residual of blocks at rest is tested for an added slope
+// C_L / Kv with a CUSUM tuned for `design_leak`. The slope is what is identifiable: C_L = Kv
+// times the slope change, with Kv known only to +-`valve_coefficient_uncertainty`, which the
+// reported confidence interval includes. The controller's integral action or position error
+// does not matter: whatever hides the leak from x, the valve still has to deliver its flow.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "detect/cusum.hpp"
+#include "detect/detector.hpp"
+#include "detect/learning_schedule.hpp"
+#include "detect/valve_flow.hpp"
+
+namespace leakmon::detect {
+
+struct FlowBalanceOptions {
+  LearningSchedule learning;
+  ValveGeometry valve;
+  double valve_coefficient = 3.39e-7;          // nominal Kv [m^3/(s sqrt(Pa))]
+  double valve_coefficient_uncertainty = 0.1;  // relative
+  double piston_area = 6.334e-4;               // A [m^2]
+  // A hop is at rest when |dx/dt| stays below rest_speed over it and both its neighbours: a hop
+  // that holds the first or last few samples of a move carries flows the balance does not model.
+  double rest_speed = 2e-3;      // [m/s]
+  double design_leak = 2.5e-13;  // C_L the CUSUM is tuned for [m^3/(s Pa)]
+  double false_alarms_per_hour = 0.05;
+  double block_seconds = 0.8;
+  double min_rest_fraction = 0.25;  // a block needs this share of hops at rest
+  double sizing_seconds = 60.0;     // memory of the C_L estimate when there is no change
+};
+
+class FlowBalanceDetector final : public Detector {
+ public:
+  FlowBalanceDetector(const FlowBalanceOptions& options, double hop_seconds);
+
+  std::string_view name() const override { return "flow_balance"; }
+  Decision update(const Observation& observation) override;
+  double raise_threshold() const override { return 1.0; }
+  double clear_threshold() const override { return 0.5; }
+  void reset() override;
+
+ private:
+  struct RestHop {
+    double flow, load;  // normalised load flow and load pressure
+    std::size_t block;  // block number, to regroup the learning data
+  };
+  struct Hop {
+    double flow = kMissing, load = kMissing, speed = kMissing;
+    bool usable = false;  // all signals present and the command within the valve's range
+  };
+  double expected_flow(double load) const;
+  void accept(const Hop& hop, bool at_rest);
+  void finish_learning();
+  void judge_block(double mean_residual, double mean_load);
+
+  FlowBalanceOptions options_;
+  double hop_seconds_;
+  std::size_t settle_hops_, learn_hops_, block_hops_, min_rest_hops_;
+  double design_slope_;  // design_leak in the normalised units of the regression
+  double sizing_decay_;  // per block
+  std::size_t observations_ = 0;
+  std::size_t hops_seen_ = 0;  // accepted hops (one behind the observations)
+  double previous_x_ = kMissing;
+  Hop before_, pending_;          // the two latest hops; pending_ is judged when the next arrives
+  std::vector<RestHop> learned_;  // reserved at construction
+  bool learned_model_ = false;
+  double coefficients_[3] = {0.0, 0.0, 0.0};  // flow = c0 + c1 load + c2 sign(load)
+  double block_sigma_ = kMissing;
+  // The current block.
+  std::size_t block_hop_ = 0, block_rest_hops_ = 0;
+  double block_residual_sum_ = 0.0, block_load_sum_ = 0.0;
+  // The added slope by least squares of residual on load. While the CUSUM is positive, over
+  // the blocks since it last left zero (its estimate of the change time), so that the size in
+  // an alarm is not diluted by healthy data; otherwise exponentially weighted.
+  struct SlopeSums {
+    double rl = 0.0, ll = 0.0, ll_sq = 0.0;  // sum r*l, sum l^2 (weights w), sum w^2 l^2
+  };
+  SlopeSums weighted_, since_change_;
+  Cusum cusum_;
+  Decision last_;
+};
+
+}  // namespace leakmon::detect

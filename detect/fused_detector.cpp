@@ -1,0 +1,39 @@
+#include "detect/fused_detector.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace leakmon::detect {
+
+FusedDetector::FusedDetector(std::vector<std::unique_ptr<Detector>> members)
+    : members_(std::move(members)), member_decisions_(members_.size()) {}
+
+void FusedDetector::reset() {
+  for (auto& member : members_) member->reset();
+  for (auto& decision : member_decisions_) decision = Decision{};
+}
+
+Decision FusedDetector::update(const Observation& observation) {
+  Decision fused;
+  fused.learning = false;
+  for (std::size_t i = 0; i < members_.size(); ++i) {
+    const Decision d = members_[i]->update(observation);
+    member_decisions_[i] = d;
+    fused.learning = fused.learning || d.learning;
+    if (!std::isnan(d.score)) {
+      const double relative = d.score / members_[i]->raise_threshold();
+      if (std::isnan(fused.score) || relative > fused.score) fused.score = relative;
+    }
+    if (std::isnan(fused.index) && !std::isnan(d.index)) {
+      fused.index = d.index;
+      fused.baseline = d.baseline;
+    }
+    if (std::isnan(fused.leak_coefficient) && !std::isnan(d.leak_coefficient)) {
+      fused.leak_coefficient = d.leak_coefficient;
+      fused.leak_coefficient_ci = d.leak_coefficient_ci;
+    }
+  }
+  return fused;
+}
+
+}  // namespace leakmon::detect

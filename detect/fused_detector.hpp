@@ -1,0 +1,34 @@
+// Runs several detectors on the same observations and raises when any of them would: the
+// score is the largest of their scores, each divided by its own raise threshold. Each member
+// gets a share of the false-alarm budget (the factory sets that up), so the union keeps the
+// target rate. The leak size comes from the first member that can size a leak.
+#pragma once
+
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "detect/detector.hpp"
+
+namespace leakmon::detect {
+
+class FusedDetector final : public Detector {
+ public:
+  explicit FusedDetector(std::vector<std::unique_ptr<Detector>> members);
+
+  std::string_view name() const override { return "fused"; }
+  Decision update(const Observation& observation) override;
+  double raise_threshold() const override { return 1.0; }
+  double clear_threshold() const override { return 0.5; }
+  void reset() override;
+
+  // The latest decision of each member (same order as given), for diagnostics and evaluation.
+  const std::vector<Decision>& member_decisions() const { return member_decisions_; }
+  const std::vector<std::unique_ptr<Detector>>& members() const { return members_; }
+
+ private:
+  std::vector<std::unique_ptr<Detector>> members_;
+  std::vector<Decision> member_decisions_;
+};
+
+}  // namespace leakmon::detect

@@ -1,0 +1,157 @@
+#include "model/calibration_fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <unsupported/Eigen/LevenbergMarquardt>
+
+namespace leakmon::model {
+namespace {
+
+// Solver coordinates: the calibration as value / scale, an effect parameter as
+// 1 + (value - initial) / scale, so that every unknown starts near 1 and a unit step in any
+// of them is a comparable change of the model.
+constexpr int kCalibrationCount = 4;  // beta, Kv, m, b
+constexpr double kScales[kCalibrationCount] = {1e8, 1e-7, 1.0, 100.0};
+constexpr double kFloors[kCalibrationCount] = {0.05, 0.05, 0.1, 0.0};  // keep the model sane
+
+class SegmentFitProblem : public Eigen::DenseFunctor<double> {
+ public:
+  // Only the calibration parameters flagged in `free` are unknowns; the others stay at `start`.
+  SegmentFitProblem(const SegmentPredictor& predictor, std::span<const Segment> segments,
+                    const EffectCandidate* candidate, const Calibration& start,
+                    const CalibrationMask& free)
+      : Eigen::DenseFunctor<double>(
+            static_cast<int>(std::count(free.begin(), free.end(), true)) +
+                static_cast<int>(candidate ? candidate->parameters.size() : 0),
+            static_cast<int>(SegmentPredictor::residual_count(segments))),
+        predictor_(predictor),
+        segments_(segments),
+        candidate_(candidate),
+        start_(start) {
+    for (int i = 0; i < kCalibrationCount; ++i) {
+      if (free[static_cast<std::size_t>(i)]) calibration_slot_[i] = first_effect_++;
+    }
+  }
+
+  int first_effect() const { return first_effect_; }
+  int calibration_slot(int i) const { return calibration_slot_[i]; }
+
+  InputType start_point() const {
+    InputType theta = InputType::Ones(inputs());
+    const double start[kCalibrationCount] = {start_.beta, start_.Kv, start_.m, start_.b};
+    for (int i = 0; i < kCalibrationCount; ++i) {
+      if (calibration_slot_[i] >= 0) theta[calibration_slot_[i]] = start[i] / kScales[i];
+    }
+    return theta;
+  }
+
+  ModelParameters model(const InputType& theta) const {
+    ModelParameters p;
+    p.calibration = start_;
+    double* values[kCalibrationCount] = {&p.calibration.beta, &p.calibration.Kv, &p.calibration.m,
+                                         &p.calibration.b};
+    for (int i = 0; i < kCalibrationCount; ++i) {
+      if (calibration_slot_[i] < 0) continue;
+      *values[i] = std::max(theta[calibration_slot_[i]], kFloors[i]) * kScales[i];
+    }
+    if (candidate_) candidate_->apply(p.effects, effect_values(theta));
+    return p;
+  }
+
+  std::vector<double> effect_values(const InputType& theta) const {
+    std::vector<double> v;
+    if (!candidate_) return v;
+    for (std::size_t i = 0; i < candidate_->parameters.size(); ++i) {
+      const auto& fp = candidate_->parameters[i];
+      const double t = theta[first_effect_ + static_cast<int>(i)];
+      v.push_back(std::clamp(fp.initial + (t - 1.0) * fp.scale, fp.lower, fp.upper));
+    }
+    return v;
+  }
+
+  int operator()(const InputType& theta, ValueType& residuals) const {
+    ++evaluations_;
+    predictor_.residuals(model(theta), segments_,
+                         std::span<double>(residuals.data(), static_cast<std::size_t>(
+                                                                 residuals.size())));
+    return 0;
+  }
+
+  // Forward differences with steps relative to each unknown's typical size (1 in solver
+  // coordinates): parameters that start at zero still get a meaningful step.
+  int df(const InputType& theta, JacobianType& jacobian) const {
+    ValueType base(values());
+    (*this)(theta, base);
+    ValueType shifted(values());
+    for (int j = 0; j < theta.size(); ++j) {
+      InputType t = theta;
+      const double h = 1e-5 * std::max(std::abs(theta[j]), 1.0);
+      t[j] += h;
+      (*this)(t, shifted);
+      jacobian.col(j) = (shifted - base) / h;
+    }
+    return 0;
+  }
+
+  int evaluations() const { return evaluations_; }
+
+ private:
+  const SegmentPredictor& predictor_;
+  std::span<const Segment> segments_;
+  const EffectCandidate* candidate_;
+  Calibration start_;
+  int calibration_slot_[kCalibrationCount] = {-1, -1, -1, -1};
+  int first_effect_ = 0;
+  mutable int evaluations_ = 0;
+};
+
+}  // namespace
+
+FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> segments,
+                    const EffectCandidate* candidate, const Calibration& start,
+                    const FitSettings& settings) {
+  SegmentFitProblem problem(predictor, segments, candidate, start, settings.free_calibration);
+  Eigen::VectorXd theta = problem.start_point();
+  Eigen::LevenbergMarquardt<SegmentFitProblem> solver(problem);
+  solver.setMaxfev(settings.max_iterations);
+  solver.setXtol(1e-5);
+  solver.setFtol(1e-6);
+  solver.minimize(theta);
+
+  FitResult result;
+  result.parameters = problem.model(theta);
+  result.values = problem.effect_values(theta);
+  Eigen::VectorXd residuals(problem.values());
+  problem(theta, residuals);
+  result.cost = residuals.squaredNorm() / static_cast<double>(residuals.size());
+
+  if (settings.uncertainties) {
+    // Gauss-Newton covariance s^2 (J^T J)^-1. The residuals of one segment are correlated, so
+    // these errors are optimistic; they rank how well the data pin each parameter down.
+    Eigen::MatrixXd jacobian(problem.values(), problem.inputs());
+    problem.df(theta, jacobian);
+    const double dof = std::max<double>(1.0, residuals.size() - theta.size());
+    const double s2 = residuals.squaredNorm() / dof;
+    const Eigen::MatrixXd info = jacobian.transpose() * jacobian;
+    const Eigen::MatrixXd cov = s2 * info.completeOrthogonalDecomposition().pseudoInverse();
+    const auto err = [&](int j) { return std::sqrt(std::max(cov(j, j), 0.0)); };
+    double* errors[kCalibrationCount] = {&result.calibration_errors.beta,
+                                         &result.calibration_errors.Kv,
+                                         &result.calibration_errors.m, &result.calibration_errors.b};
+    for (int i = 0; i < kCalibrationCount; ++i) {
+      const int slot = problem.calibration_slot(i);
+      *errors[i] = slot >= 0 ? err(slot) * kScales[i] : 0.0;
+    }
+    if (candidate) {
+      for (std::size_t i = 0; i < candidate->parameters.size(); ++i) {
+        result.value_errors.push_back(err(problem.first_effect() + static_cast<int>(i)) *
+                                      candidate->parameters[i].scale);
+      }
+    }
+  }
+  result.evaluations = problem.evaluations();
+  return result;
+}
+
+}  // namespace leakmon::model

@@ -1,0 +1,38 @@
+// Least-squares fit of a model to the fitting segments (multiple shooting), with Eigen's
+// Levenberg-Marquardt (unsupported/Eigen/LevenbergMarquardt, MINPACK's algorithm). The
+// calibratable parameters beta, Kv, m, b are always free; an effect candidate adds its own.
+#pragma once
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "model/effect_library.hpp"
+#include "model/segment_predictor.hpp"
+
+namespace leakmon::model {
+
+using CalibrationMask = std::array<bool, 4>;  // beta, Kv, m, b
+
+struct FitSettings {
+  int max_iterations = 15;  // solver steps (each with a Jacobian: one simulation per unknown)
+  bool uncertainties = false; // also compute standard errors (one more Jacobian)
+  CalibrationMask free_calibration = {true, true, true, true};  // others stay at `start`
+};
+
+struct FitResult {
+  ModelParameters parameters;         // the fitted model
+  std::vector<double> values;         // the candidate's parameters [SI], clamped as applied
+  std::vector<double> value_errors;   // their standard errors (when requested), same order
+  Calibration calibration_errors;     // standard errors of beta, Kv, m, b (when requested)
+  double cost = 0.0;                  // mean squared scaled residual on the fitting segments
+  int evaluations = 0;
+};
+
+// `candidate` null fits the calibrated nominal model. `start` gives the calibration's starting
+// point (effects in it are ignored).
+FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> segments,
+                    const EffectCandidate* candidate, const Calibration& start,
+                    const FitSettings& settings = {});
+
+}  // namespace leakmon::model

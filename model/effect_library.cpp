@@ -1,0 +1,104 @@
+#include "model/effect_library.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace leakmon::model {
+namespace {
+
+double value_of(const std::vector<double>& values, std::size_t i) {
+  return i < values.size() ? values[i] : 0.0;
+}
+
+}  // namespace
+
+const std::vector<std::string>& effect_names() {
+  static const std::vector<std::string> names = {
+      "internal_leakage", "external_leakage", "coulomb_friction", "entrained_air",
+      "valve_overlap",    "valve_bias",       "spool_lag",        "supply_ripple",
+      "supply_droop",     "sensor_offset",    "sensor_lag"};
+  return names;
+}
+
+void EffectCandidate::apply(EffectParameters& e, const std::vector<double>& values) const {
+  std::vector<double> v(parameters.size());
+  for (std::size_t i = 0; i < parameters.size(); ++i) {
+    v[i] = std::clamp(value_of(values, i), parameters[i].lower, parameters[i].upper);
+  }
+  const auto channel = variant == "p2" ? PressureChannel::p2 : PressureChannel::p1;
+  if (effect == "internal_leakage") {
+    e.C_L = v[0];
+  } else if (effect == "external_leakage") {
+    e.C_E = v[0];
+    e.external_chamber = variant == "chamber 2" ? 2 : 1;
+  } else if (effect == "coulomb_friction") {
+    e.F_C = v[0];
+  } else if (effect == "entrained_air") {
+    e.alpha = v[0];
+  } else if (effect == "valve_overlap") {
+    e.d = v[0];
+  } else if (effect == "valve_bias") {
+    e.u0 = v[0];
+  } else if (effect == "spool_lag") {
+    e.spool_tau = v[0];
+  } else if (effect == "supply_ripple") {
+    e.ripple_dP = v[0];
+    e.ripple_f = v[1];
+    e.ripple_dQ = v[2];
+  } else if (effect == "supply_droop") {
+    e.R_s = v[0];
+  } else if (effect == "sensor_offset") {
+    e.offset = v[0];
+    e.offset_channel = channel;
+  } else if (effect == "sensor_lag") {
+    e.tau_s = v[0];
+    e.lag_channel = channel;
+  }
+}
+
+bool EffectCandidate::plausible(const std::vector<double>& values) const {
+  const double main = value_of(values, 0);
+  const auto& p = parameters.front();
+  // A main parameter pinned at a bound means the effect's shape does not fit the data.
+  const double span = p.upper - p.lower;
+  if (main <= p.lower + 1e-3 * span || main >= p.upper - 1e-3 * span) return false;
+  if (effect == "spool_lag") return main > 1.5 * 2.5e-3;  // slower than the nominal spool
+  // Leaks, friction, air, dead band and droop have a sign; the solver may cross zero, but a
+  // negative one is not an instance of the effect.
+  const bool signed_effect = effect == "valve_bias" || effect == "supply_ripple" ||
+                             effect == "sensor_offset" || effect == "sensor_lag";
+  return signed_effect || main > 0.0;
+}
+
+std::vector<EffectCandidate> effect_library(double ripple_hz) {
+  std::vector<EffectCandidate> out;
+  out.push_back({"internal_leakage", "", {{"C_L", 1e-12, 1e-12, -2e-12, 5e-11}}});
+  for (const char* chamber : {"chamber 1", "chamber 2"}) {
+    out.push_back({"external_leakage", chamber, {{"C_E", 1e-12, 5e-13, -1e-12, 2e-11}}});
+  }
+  out.push_back({"coulomb_friction", "", {{"F_C", 100.0, 100.0, -200.0, 4000.0}},
+                 {false, false, false, true}});
+  out.push_back({"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}},
+                 {true, false, false, false}});
+  out.push_back({"valve_overlap", "", {{"d", 0.01, 0.01, -0.01, 0.2}}});
+  out.push_back({"valve_bias", "", {{"u0", 0.1, 0.02, -3.0, 3.0}}});
+  out.push_back({"spool_lag", "", {{"tau", 0.005, 0.006, 5e-4, 0.1}}});
+  if (ripple_hz > 0.0) {
+    out.push_back({"supply_ripple",
+                   "",
+                   {{"dP", 1e5, 1e5, -5e6, 5e6},
+                    {"f", 1e-3, ripple_hz, ripple_hz - 1.0, ripple_hz + 1.0},
+                    {"", 1e5, 0.0, -5e6, 5e6}}});
+  }
+  out.push_back({"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}},
+                 {false, true, false, false}});
+  for (const char* channel : {"p1", "p2"}) {
+    out.push_back({"sensor_offset", channel, {{"offset", 1e5, 0.0, -3e6, 3e6}}});
+  }
+  for (const char* channel : {"p1", "p2"}) {
+    out.push_back({"sensor_lag", channel, {{"tau_s", 0.002, 0.004, 5e-4, 0.1}}});
+  }
+  return out;
+}
+
+}  // namespace leakmon::model

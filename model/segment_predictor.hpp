@@ -1,0 +1,82 @@
+// "Simulating the model on the measured inputs" (docs/model-check.md): the plant integrates the
+// valve flow into position, so a free open-loop run on the measured command drifts away for
+// reasons that say nothing about the model. The record is therefore cut into short segments;
+// each starts from the measured state (x, p1, p2 as read, v from a local fit of x, the spool
+// from the exact zero-order-hold response to the measured u) and is simulated open loop on the
+// measured u for its whole length. The same segment simulation serves fitting (least squares
+// on the segment errors: multiple shooting) and scoring (NRMSE on held-out segments).
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "model/actuator_model.hpp"
+#include "model/measured_record.hpp"
+
+namespace leakmon::model {
+
+struct Segment {
+  std::size_t begin = 0;
+  std::size_t length = 0;
+};
+
+struct SegmentPlan {
+  std::vector<Segment> fitting;   // the whole fitting part
+  std::vector<Segment> held_out;  // data never used for fitting
+};
+
+struct SplitSettings {
+  double block_s = 4.0;    // fitting and held-out blocks alternate with this length
+  double segment_s = 0.5;  // length of one simulated segment
+};
+
+// Alternating blocks: a trend in the operating point cannot make the held-out part a different
+// regime from the fitting part. Segments containing a gap are left out.
+SegmentPlan split_record(const MeasuredRecord& record, const SplitSettings& settings = {});
+// At most `count` segments, spread evenly over `segments` (to bound the cost of fitting).
+std::vector<Segment> spread(std::span<const Segment> segments, std::size_t count);
+
+// Predicted readings, record-sized; NaN outside the simulated segments.
+struct Prediction {
+  std::vector<double> x, p1, p2;
+};
+
+struct ChannelScales {
+  double x = 1.0, p1 = 1.0, p2 = 1.0;
+};
+
+class SegmentPredictor {
+ public:
+  explicit SegmentPredictor(const MeasuredRecord& record, const RigConstants& rig = {});
+
+  const MeasuredRecord& record() const { return record_; }
+  const ChannelScales& scales() const { return scales_; }
+
+  void predict(const ModelParameters& parameters, std::span<const Segment> segments,
+               Prediction& out) const;
+  // Number of residuals residuals() writes for these segments.
+  static std::size_t residual_count(std::span<const Segment> segments);
+  // (prediction - measurement) / channel scale for x, p1, p2 at every sample after each
+  // segment's first; 0 where a sample is missing. Huge values when the model blows up.
+  void residuals(const ModelParameters& parameters, std::span<const Segment> segments,
+                 std::span<double> out) const;
+  // FORMATS.md's nrmse: per channel RMS error over std of the measurement, averaged over x, p1,
+  // p2, on the given segments.
+  double nrmse(const ModelParameters& parameters, std::span<const Segment> segments) const;
+  double nrmse(const Prediction& prediction, std::span<const Segment> segments) const;
+
+ private:
+  std::vector<double> spool_positions(const ActuatorModel& model) const;
+  template <typename Visit>
+  void run(const ModelParameters& parameters, std::span<const Segment> segments,
+           Visit&& visit) const;
+
+  const MeasuredRecord& record_;
+  RigConstants rig_;
+  ChannelScales scales_;
+  std::vector<double> velocity_;   // from a local least-squares line through x
+  std::vector<double> dp1_, dp2_;  // central differences of the pressure readings
+};
+
+}  // namespace leakmon::model

@@ -1,0 +1,15 @@
+// Friction on the piston: viscous b v (MODEL.md "piston") and the effect library's Coulomb
+// friction F_C tanh(v / 1e-3), smooth so that a fixed-step integrator can cross v = 0.
+#pragma once
+
+#include <cmath>
+
+namespace leakmon::sim {
+
+inline constexpr double kCoulombVelocityScale = 1e-3;  // m/s
+
+inline double coulomb_friction(double F_C, double v) noexcept {
+  return F_C * std::tanh(v / kCoulombVelocityScale);
+}
+
+}  // namespace leakmon::sim

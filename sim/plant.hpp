@@ -1,0 +1,118 @@
+// The continuous actuator of MODEL.md (spool, valve, chambers, piston, end stops) with the
+// effect library, integrated by fixed-step RK4 over one sample with the command held. Usable
+// open-loop (the model check drives it with a measured u) or inside Rig.
+//
+// The spool flow noise is an Ornstein-Uhlenbeck process drawn by its exact discretisation on a
+// fixed grid (kNoiseGridStep = 0.25 ms) and interpolated
+// linearly, so the noise input does not depend on the integration step and trajectories
+// converge as the step shrinks.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "sim/effects.hpp"
+#include "sim/flow_noise.hpp"
+#include "sim/leakage.hpp"
+#include "sim/parameters.hpp"
+
+namespace leakmon::sim {
+
+struct PlantState {
+  double xs = 0.0;  // spool position, normalised -1..1
+  double x = 0.0;   // piston position [m], 0 at mid-stroke
+  double v = 0.0;   // piston velocity [m/s]
+  double p1 = 0.0;  // chamber pressures [Pa gauge]
+  double p2 = 0.0;
+  // Pressures at the transducer outputs: equal to p1, p2 unless sensor_lag delays one.
+  double p1_transducer = 0.0;
+  double p2_transducer = 0.0;
+  // Fluid ledger, integrated with the states (for the mass-balance check): the integral of
+  // rho(p_i)/rho(0) times the net port flow into chamber i, with rho(p) = exp(p / beta) the
+  // density law implied by the continuity equation at constant beta; and the plain volume of
+  // cross-port leakage [m^3].
+  double mass_in1 = 0.0;
+  double mass_in2 = 0.0;
+  double leaked_volume = 0.0;
+};
+
+// Every flow and the supply pressure at one instant (the terms of MODEL.md's equations).
+struct PlantFlows {
+  double ps;              // supply pressure after ripple and droop [Pa]
+  double w;               // spool flow noise (fraction of travel)
+  double opening;         // effective opening after noise and overlap
+  double q1, q2;          // valve flows into chambers 1 and 2, null leakage included [m^3/s]
+  double q_supply;        // flow out of the supply port [m^3/s]
+  double q_int;           // cross-port leakage 1 -> 2 [m^3/s]
+  double q_ext1, q_ext2;  // external leakage to tank [m^3/s]
+  double C_L;             // internal leakage coefficient in force now
+};
+
+class Plant {
+ public:
+  // Allocates nothing after construction.
+  Plant(const Parameters& params, const Effects& effects, std::uint64_t noise_seed,
+        double integration_step_s = 1e-4);
+
+  // Rest state of MODEL.md's simulation conventions: x = v = xs = 0, p1 = p2 = (ps + pt)/2,
+  // noise restarted from its seed, time 0.
+  void reset();
+  // Sets an explicit initial state (e.g. a measured one); transducer states follow p1, p2.
+  void set_state(const PlantState& state);
+
+  // Integrates from t0 to t0 + dt with the valve command u [V] held. t0 must continue from the
+  // previous call's end (the noise grid is indexed by absolute time). Allocation-free.
+  void advance(double u, double t0, double dt) noexcept;
+
+  const PlantState& state() const { return state_; }
+  double time() const { return time_; }
+  double leak_flow() const;  // q_int at state() and time()
+  PlantFlows flows() const;  // every flow at state() and time()
+
+  // Runtime leak injection (the daemon's sim driver): C_L from onset_s on, ramped over ramp_s.
+  void set_internal_leak(double C_L, double onset_s, double ramp_s = 0.0) noexcept;
+  // Turns the mass ledger of PlantState on (costs two exp() per derivative evaluation).
+  void enable_ledger(bool on) { ledger_ = on; }
+
+  void set_integration_step(double h);
+  double integration_step() const { return step_; }
+  const Parameters& parameters() const { return params_; }
+  const Effects& effects() const { return effects_; }
+
+ private:
+  // The integrated state: PlantState's members in declaration order.
+  using Vector = Eigen::Matrix<double, 10, 1>;
+  // Constants derived once from the parameters and effects, so the inner loop does no
+  // optional<> look-ups or repeated geometry.
+  struct Coefficients {
+    double A, V0, V_min, half_stroke, tau_spool, u_bias;
+    double overlap;  // 0 when valve_overlap is off
+    double ripple_dP, ripple_omega, droop_R_s;
+    double C_E;  // 0 when external_leakage is off
+    int external_chamber;
+    double F_C;    // 0 when coulomb_friction is off
+    double alpha;  // 0 when entrained_air is off
+    double lag_tau_s;
+    bool lag_p1, lag_p2;
+  };
+
+  // leak_t: the time at which the leak schedule is read (see advance()).
+  PlantFlows evaluate(double t, double leak_t, double xs, double p1, double p2,
+                      double w) const noexcept;
+  void rates(double t, double u, const Vector& y, Vector& dy) noexcept;
+  void store(const Vector& y);
+
+  Parameters params_;
+  Effects effects_;
+  Coefficients c_;
+  FlowNoise noise_;
+  LeakSchedule leak_;
+  Vector y_;
+  PlantState state_;
+  double time_ = 0.0;
+  double step_midpoint_ = 0.0;
+  double step_;
+  bool ledger_ = false;
+};
+
+}  // namespace leakmon::sim

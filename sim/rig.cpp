@@ -1,0 +1,52 @@
+#include "sim/rig.hpp"
+
+namespace leakmon::sim {
+
+Rig::Rig(const Scenario& scenario)
+    : scenario_(scenario),
+      period_(1.0 / scenario.sample_rate_hz),
+      reference_(scenario.reference, stream_seed(scenario.seed, RandomStream::reference)),
+      controller_(scenario.controller, scenario.sample_rate_hz, scenario.params.u_max),
+      plant_(scenario.params, scenario.effects,
+             stream_seed(scenario.seed, RandomStream::flow_noise), integration_step(scenario)),
+      sensors_(scenario.sensors, scenario.effects,
+               stream_seed(scenario.seed, RandomStream::sensors)) {}
+
+void Rig::reset() {
+  reference_.reset();
+  controller_.reset();
+  plant_.reset();
+  sensors_.reset();
+  index_ = 0;
+}
+
+void Rig::set_internal_leak(double C_L, double onset_s, double ramp_s) noexcept {
+  plant_.set_internal_leak(C_L, onset_s, ramp_s);
+}
+
+RigSample Rig::step() noexcept {
+  // MODEL.md "Simulation conventions": measure, compute u from the measured position, record,
+  // then integrate the next sample with u held.
+  const double t = static_cast<double>(index_) * period_;
+  const PlantState& s = plant_.state();
+  RigSample sample{};
+  sample.t = t;
+  sample.xref = reference_.at(t);
+  const Measurement measured = sensors_.measure(s.x, s.p1_transducer, s.p2_transducer);
+  sample.u = controller_.update(sample.xref, measured.x);
+  sample.x = measured.x;
+  sample.p1 = measured.p1;
+  sample.p2 = measured.p2;
+  sample.q_int = plant_.leak_flow();
+  sample.x_true = s.x;
+  sample.v_true = s.v;
+  sample.p1_true = s.p1;
+  sample.p2_true = s.p2;
+  sample.xs_true = s.xs;
+  sample.ps_true = plant_.flows().ps;
+  plant_.advance(sample.u, t, period_);
+  ++index_;
+  return sample;
+}
+
+}  // namespace leakmon::sim

@@ -1,0 +1,52 @@
+// A simulation run: controller, duration, seed, reference, parameters, effects, sensors.
+// Read from YAML (sim/scenarios/*.yaml) through config::ConfigNode, so that unknown keys and
+// out-of-range values fail with file:line:column and the field's path; or built from a preset.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/controller.hpp"
+#include "sim/effects.hpp"
+#include "sim/parameters.hpp"
+#include "sim/reference.hpp"
+#include "sim/sensors.hpp"
+
+namespace leakmon::sim {
+
+struct Scenario {
+  std::string name = "healthy";
+  std::string origin;  // "preset paper-fig13" or "scenario path/to/file.yaml", for metadata
+  ControllerKind controller = ControllerKind::basic;
+  double duration_s = 60.0;
+  std::uint64_t seed = 1;
+  ReferenceSettings reference;
+  Parameters params;
+  Effects effects;
+  SensorSettings sensors;
+  double sample_rate_hz = 500.0;
+  // RK4 step; 0 chooses automatic_integration_step(). Must divide the sample period.
+  double integration_step_s = 0.0;
+
+  std::uint64_t samples() const;  // rows of the capture: duration * rate, rounded
+};
+
+// The RK4 step used when a scenario leaves it at 0: chosen by accuracy (the step-halving test
+// in tests/sim judges it) and shortened where an effect makes the plant stiffer (Coulomb
+// friction's tanh, light masses); always an integer fraction of the sample period.
+double automatic_integration_step(const Parameters& params, const Effects& effects,
+                                  double sample_rate_hz);
+double integration_step(const Scenario& scenario);  // explicit value or the automatic one
+
+// Throws config::ConfigError ("file:line:column: path: message") on any bad input.
+Scenario load_scenario(const std::string& path);
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name);
+
+// paper-fig10, paper-fig13, paper-fig16 (MODEL.md "Paper experiments"), healthy (60 s, basic,
+// no leak), healthy-ft. Throws std::invalid_argument naming the presets on an unknown name.
+Scenario preset(std::string_view name, std::uint64_t seed);
+std::vector<std::string> preset_names();
+
+}  // namespace leakmon::sim

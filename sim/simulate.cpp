@@ -1,0 +1,121 @@
+#include "sim/simulate.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <variant>
+
+#include "sim/rig.hpp"
+
+namespace leakmon::sim {
+namespace {
+
+const std::vector<std::string> kColumns = {"t", "xref", "u", "x", "p1", "p2", "q_int"};
+
+std::array<double, 7> row(const RigSample& s) {
+  return {s.t, s.xref, s.u, s.x, s.p1, s.p2, s.q_int};
+}
+
+std::string format_params(const std::vector<EffectParameter>& params) {
+  std::string out;
+  for (const auto& param : params) {
+    if (!out.empty()) out += ' ';
+    if (const double* value = std::get_if<double>(&param.value)) {
+      out += fmt::format("{}={:g}", param.name, *value);
+    } else {
+      out += fmt::format("{}={}", param.name, std::get<std::string>(param.value));
+    }
+  }
+  return out;
+}
+
+// Parameters that differ from MODEL.md's nominal table, "name=value" separated by spaces.
+std::string overridden_parameters(const Parameters& p) {
+  const Parameters n = Parameters::nominal();
+  std::string out;
+  const auto check = [&](std::string_view name, double value, double nominal) {
+    if (value == nominal) return;
+    if (!out.empty()) out += ' ';
+    out += fmt::format("{}={:g}", name, value);
+  };
+  check("D", p.D, n.D);
+  check("d", p.d, n.d);
+  check("L", p.L, n.L);
+  check("V_dead", p.V_dead, n.V_dead);
+  check("V_line", p.V_line, n.V_line);
+  check("ps", p.ps, n.ps);
+  check("pt", p.pt, n.pt);
+  check("beta", p.beta, n.beta);
+  check("m", p.m, n.m);
+  check("b", p.b, n.b);
+  check("K_s", p.K_s, n.K_s);
+  check("Kv", p.Kv, n.Kv);
+  check("tau", p.tau, n.tau);
+  check("u_max", p.u_max, n.u_max);
+  check("dp_lin", p.dp_lin, n.dp_lin);
+  check("C_n", p.C_n, n.C_n);
+  check("sigma_w", p.sigma_w, n.sigma_w);
+  check("tau_w", p.tau_w, n.tau_w);
+  check("K_stop", p.K_stop, n.K_stop);
+  check("c_stop", p.c_stop, n.c_stop);
+  return out;
+}
+
+}  // namespace
+
+io::Metadata capture_metadata(const Scenario& scenario) {
+  io::Metadata meta;
+  meta.emplace_back("sample_rate_hz", fmt::format("{:g}", scenario.sample_rate_hz));
+  meta.emplace_back(
+      "source", fmt::format("sim {} seed {}",
+                            scenario.origin.empty() ? "scenario " + scenario.name : scenario.origin,
+                            scenario.seed));
+  meta.emplace_back("scenario", scenario.name);
+  meta.emplace_back("seed", fmt::format("{}", scenario.seed));
+  meta.emplace_back("controller", std::string(to_string(scenario.controller)));
+  meta.emplace_back("duration_s", fmt::format("{:g}", scenario.duration_s));
+  meta.emplace_back("integration_step_s", fmt::format("{:g}", integration_step(scenario)));
+  const auto effects = scenario.effects.describe();
+  if (effects.empty()) meta.emplace_back("effects", "none");
+  for (const auto& effect : effects) {
+    meta.emplace_back("effect", fmt::format("{} {}", effect.name, format_params(effect.params)));
+  }
+  const std::string overrides = overridden_parameters(scenario.params);
+  meta.emplace_back("params", overrides.empty() ? "nominal" : overrides);
+  const SensorSettings& s = scenario.sensors;
+  meta.emplace_back(
+      "sensors",
+      s.enabled
+          ? fmt::format("pressure {} bit 0..{:g} Pa{} noise {:g} Pa; position resolution {:g} m{} "
+                        "noise {:g} m",
+                        s.pressure_bits, s.pressure_full_scale,
+                        s.pressure_quantisation ? "" : " (unquantised)", s.pressure_noise_sigma,
+                        s.position_resolution, s.position_quantisation ? "" : " (unquantised)",
+                        s.position_noise_sigma)
+          : std::string("ideal (true values)"));
+  return meta;
+}
+
+io::Capture simulate(const Scenario& scenario) {
+  io::Capture capture;
+  capture.metadata = capture_metadata(scenario);
+  capture.columns = kColumns;
+  const std::uint64_t n = scenario.samples();
+  capture.values.assign(kColumns.size(), std::vector<double>(n));
+  Rig rig(scenario);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const auto values = row(rig.step());
+    for (std::size_t c = 0; c < values.size(); ++c) capture.values[c][k] = values[c];
+  }
+  return capture;
+}
+
+void simulate_to_file(const Scenario& scenario, const std::string& path) {
+  io::CaptureWriter writer(path, kColumns, capture_metadata(scenario));
+  Rig rig(scenario);
+  const std::uint64_t n = scenario.samples();
+  for (std::uint64_t k = 0; k < n; ++k) writer.write_row(row(rig.step()));
+  writer.close();
+}
+
+}  // namespace leakmon::sim

@@ -1,0 +1,185 @@
+// Detectors on synthetic observation streams with known truth (synthetic_rig.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "detect/factory.hpp"
+#include "detect/fused_detector.hpp"
+#include "tests/detect/synthetic_rig.hpp"
+#include "tests/support/alloc_counter.hpp"
+
+namespace leakmon::detect {
+namespace {
+
+constexpr AvailableSignals kAll{true, true, true, true};
+constexpr AvailableSignals kPressuresOnly{true, true, false, false};
+
+struct RunResult {
+  double first_raise = -1.0;  // time of the first hop with score >= raise threshold
+  double max_healthy_score = 0.0;
+  Decision last;
+};
+
+// Feeds `seconds` of the rig to the detector; healthy hops are those before the rig's onset.
+RunResult run(Detector& detector, test::SyntheticRig& rig, double seconds) {
+  RunResult result;
+  while (rig.t < seconds) {
+    const Observation o = rig.next();
+    result.last = detector.update(o);
+    if (std::isnan(result.last.score)) continue;
+    if (o.t < rig.onset) {
+      result.max_healthy_score = std::max(result.max_healthy_score, result.last.score);
+    }
+    if (result.first_raise < 0 && result.last.score >= detector.raise_threshold()) {
+      result.first_raise = o.t;
+    }
+  }
+  return result;
+}
+
+TEST(DetectorFactory, DefaultDependsOnAcquiredChannels) {
+  EXPECT_EQ(default_detector_kind(kAll), "fused");
+  EXPECT_EQ(default_detector_kind(kPressuresOnly), "index_cusum");
+  EXPECT_EQ(default_detector_kind(AvailableSignals{true, false, false, false}), "index_cusum");
+  EXPECT_EQ(make_detector("default", kAll, 0.04, nullptr)->name(), "fused");
+  EXPECT_EQ(make_detector("default", kPressuresOnly, 0.04, nullptr)->name(), "index_cusum");
+  for (const auto& kind : detector_kinds()) {
+    EXPECT_NE(make_detector(kind, kAll, 0.04, nullptr), nullptr) << kind;
+  }
+}
+
+TEST(DetectorFactory, RejectsUnknownKindAndMissingChannels) {
+  EXPECT_THROW(make_detector("magic", kAll, 0.04, nullptr), std::invalid_argument);
+  EXPECT_THROW(make_detector("flow_balance", kPressuresOnly, 0.04, nullptr), std::invalid_argument);
+  EXPECT_THROW(make_detector("paper", AvailableSignals{}, 0.04, nullptr), std::invalid_argument);
+  EXPECT_THROW(make_detector("paper", kAll, 0.0, nullptr), std::invalid_argument);
+}
+
+TEST(DetectorFactory, OptionErrorsNameFileLineAndKey) {
+  const auto typo =
+      config::ConfigNode::load_string("learn_seconds: 30\ndesing_drop: 0.1\n", "detector.yaml");
+  try {
+    make_detector("index_cusum", kAll, 0.04, &typo);
+    FAIL() << "unknown key accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("detector.yaml:2:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("desing_drop"), std::string::npos) << e.what();
+  }
+  const auto range = config::ConfigNode::load_string("design_drop: 1.5\n", "d.yaml");
+  try {
+    make_detector("index_cusum", kAll, 0.04, &range);
+    FAIL() << "out-of-range value accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("d.yaml:1:"), std::string::npos) << e.what();
+  }
+  const auto good = config::ConfigNode::load_string(
+      "learn_seconds: 30\ndesign_leak: 2.0e-12\nrest_speed: 0.003\n", "good.yaml");
+  EXPECT_EQ(make_detector("default", kAll, 0.04, &good)->name(), "fused");
+}
+
+TEST(PaperBaselineDetector, LearnsBaselineAndFlagsALargeDrop) {
+  auto detector = make_detector("paper", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 300.0;
+  rig.index_drop = 0.5;  // the paper's rule only reacts to a drop well beyond the scatter
+  const RunResult r = run(*detector, rig, 400.0);
+  EXPECT_FALSE(r.last.learning);
+  EXPECT_GT(r.last.baseline, 15e3);
+  EXPECT_LT(r.last.baseline, 40e3);
+  EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
+  EXPECT_GT(r.first_raise, 300.0);
+  EXPECT_LT(r.first_raise, 330.0);
+}
+
+TEST(IndexCusumDetector, QuietWhenHealthyAndRaisesAfterADrop) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 1800.0;
+  rig.index_drop = 0.20;
+  const RunResult r = run(*detector, rig, 2000.0);
+  EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 90.0);
+  EXPECT_TRUE(std::isnan(r.last.leak_coefficient));  // the index cannot size a leak
+}
+
+TEST(IndexCusumDetector, NeedsAllConfiguredChambersAndHoldsOnGaps) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  run(*detector, rig, 100.0);
+  Observation gap = rig.next();
+  gap.index_p2 = kMissing;
+  const Decision d = detector->update(gap);
+  EXPECT_FALSE(d.learning);
+  EXPECT_TRUE(std::isnan(d.index));
+}
+
+TEST(FlowBalanceDetector, EstimatesTheLeakWithinItsInterval) {
+  auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 120.0;
+  rig.leak = 1e-12;
+  const RunResult r = run(*detector, rig, 300.0);
+  EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 30.0);
+  ASSERT_FALSE(std::isnan(r.last.leak_coefficient));
+  EXPECT_NEAR(r.last.leak_coefficient, 1e-12, r.last.leak_coefficient_ci);
+  EXPECT_LT(r.last.leak_coefficient_ci, 0.5e-12);
+}
+
+TEST(FlowBalanceDetector, QuietOnAHealthyRigWithStrongNullLeak) {
+  auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.null_leak = 1.5e-12;  // the valve's own leakage is learned, not alarmed on
+  rig.kv *= 0.9;
+  const RunResult r = run(*detector, rig, 1200.0);
+  EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
+  EXPECT_NEAR(r.last.leak_coefficient, 0.0, r.last.leak_coefficient_ci + 0.1e-12);
+}
+
+TEST(FusedDetector, RaisesOnLeakAndReportsSize) {
+  auto detector = make_detector("fused", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 150.0;
+  rig.leak = 2e-12;
+  rig.index_drop = 0.12;
+  const RunResult r = run(*detector, rig, 250.0);
+  EXPECT_LT(r.max_healthy_score, 1.0);
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 20.0);
+  EXPECT_NEAR(r.last.leak_coefficient, 2e-12, r.last.leak_coefficient_ci);
+}
+
+TEST(Detectors, UpdateAllocatesNothingAfterConstruction) {
+  for (const auto& kind : detector_kinds()) {
+    auto detector = make_detector(kind, kAll, 0.04, nullptr);
+    test::SyntheticRig rig;
+    rig.onset = 100.0;
+    rig.leak = 2e-12;
+    rig.index_drop = 0.1;
+    std::uint64_t allocations = 0;
+    for (int i = 0; i < 5000; ++i) {  // learning, detection and alarm, all in one scope
+      const Observation o = rig.next();
+      test::AllocationScope scope;
+      detector->update(o);
+      allocations += scope.count();
+    }
+    EXPECT_EQ(allocations, 0u) << kind;
+  }
+}
+
+TEST(Detectors, ResetStartsLearningAgain) {
+  for (const auto& kind : detector_kinds()) {
+    auto detector = make_detector(kind, kAll, 0.04, nullptr);
+    test::SyntheticRig rig;
+    run(*detector, rig, 150.0);
+    EXPECT_FALSE(detector->update(rig.next()).learning) << kind;
+    detector->reset();
+    EXPECT_TRUE(detector->update(rig.next()).learning) << kind;
+  }
+}
+
+}  // namespace
+}  // namespace leakmon::detect

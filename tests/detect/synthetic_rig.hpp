@@ -1,0 +1,68 @@
+// Synthetic observation streams with known truth for the detectors' unit tests: a rig holding
+// random positions against its spring, the valve command that the orifice law needs to feed a
+// given cross-piston leak, and a noise-driven wavelet index that depends on the load pressure.
+// (The simulator-based evaluation, tests/detect/evaluate_test.cpp, covers the real physics.)
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "detect/detector.hpp"
+#include "detect/valve_flow.hpp"
+
+namespace leakmon::test {
+
+struct SyntheticRig {
+  double hop = 0.04;
+  double leak = 0.0;  // C_L [m^3/(s Pa)] from `onset` on
+  double onset = 1e300;
+  double null_leak = 5e-13;   // acts as a healthy cross-port leak
+  double index_drop = 0.0;    // relative index drop once the leak is on
+  double index_noise = 0.15;  // log-index scatter per independent window
+  double kv = 3.39e-7;
+  double spring = 80e3, area = 6.334e-4;
+  detect::ValveGeometry valve;
+  std::mt19937_64 rng{1};
+
+  double t = 0.0;
+  double hold_left = 0.0, x = 0.0, target = 0.0;
+  double window_level = 0.0;  // the log-index's slowly varying part (one window memory)
+
+  detect::Observation next() {
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    t += hop;
+    hold_left -= hop;
+    if (hold_left <= 0.0) {
+      target = (uniform(rng) < 0.5 ? -1.0 : 1.0) * (0.025 + 0.025 * uniform(rng));
+      hold_left = 0.5 + 3.5 * uniform(rng);
+    }
+    const double previous_x = x;
+    x += std::clamp(target - x, -0.01, 0.01);  // moves at up to 0.25 m/s, then rests
+    const double leak_now = t >= onset ? leak : 0.0;
+    const double dp = spring * x / area;
+    const double p_mid = 0.5 * (valve.supply_pressure + valve.tank_pressure);
+    detect::Observation o;
+    o.t = t;
+    o.p1 = p_mid + dp / 2 + 2e3 * normal(rng);
+    o.p2 = p_mid - dp / 2 + 2e3 * normal(rng);
+    o.x = x + 2e-6 * normal(rng);
+    // Command whose load flow (valve_flow.hpp) feeds the leak, the null leak and the motion.
+    const double flow = (leak_now + null_leak) * dp + area * (x - previous_x) / hop;
+    const double per_opening = std::abs(detect::load_flow_per_kv(
+        valve, std::copysign(valve.command_full_scale, flow), p_mid + dp / 2, p_mid - dp / 2));
+    o.u = valve.command_full_scale * flow / (kv * per_opening) + 1e-3 * normal(rng);
+    // Index: load-dependent level, AR(1) with about one window of memory, drop after onset.
+    window_level = 0.95 * window_level + std::sqrt(1 - 0.95 * 0.95) * index_noise * normal(rng);
+    const double load = dp / valve.supply_pressure;
+    const double log_index = std::log(30e3) - 0.8 * load * load + 0.1 * load + window_level +
+                             (t >= onset ? std::log1p(-index_drop) : 0.0);
+    o.index_p1 = std::exp(log_index + 0.02 * normal(rng));
+    o.index_p2 = std::exp(log_index + 0.02 * normal(rng));
+    o.x_activity = 0.03;
+    return o;
+  }
+};
+
+}  // namespace leakmon::test

@@ -1,0 +1,78 @@
+// `leakmon sim` as FORMATS.md specifies it, run as the real binary.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "io/capture/capture.hpp"
+#include "tests/support/paths.hpp"
+
+namespace leakmon {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string output;
+};
+
+Result run(const std::string& args) {
+  const std::string command = test::leakmon_binary() + " sim " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string output;
+  char buffer[512];
+  while (pipe && std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = pipe ? pclose(pipe) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+TEST(SimCommand, PresetWritesTheCaptureWithMetadata) {
+  const std::string dir = test::scratch_dir("sim_command_preset");
+  const Result r = run("--preset paper-fig10 --seed 7 --duration 2 --out " + dir + "/fig10.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const io::Capture capture = io::read_capture(dir + "/fig10.csv");
+  for (const char* column : {"t", "xref", "u", "x", "p1", "p2", "q_int"}) {
+    EXPECT_TRUE(capture.has(column)) << column;
+  }
+  EXPECT_EQ(capture.rows(), 1000u);
+  EXPECT_EQ(capture.metadata_value("source"), "sim preset paper-fig10 seed 7");
+  EXPECT_EQ(capture.metadata_value("seed"), "7");
+  EXPECT_EQ(capture.metadata_value("effect"), "internal_leakage C_L=2e-12 onset_s=15 ramp_s=0");
+  EXPECT_EQ(capture.sample_rate_hz(), 500.0);
+}
+
+TEST(SimCommand, ScenarioFileRunsAndBadFilesFailWithTheirLocation) {
+  const std::string dir = test::scratch_dir("sim_command_scenario");
+  const Result ok =
+      run("--scenario " + test::source_dir() +
+          "/sim/scenarios/supply-disturbances.yaml --duration 1 --out " + dir + "/s.csv");
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const io::Capture capture = io::read_capture(dir + "/s.csv");
+  EXPECT_EQ(capture.rows(), 500u);
+  int effects = 0;
+  for (const auto& [key, value] : capture.metadata) effects += key == "effect";
+  EXPECT_EQ(effects, 3);
+
+  const std::string bad = dir + "/bad.yaml";
+  std::ofstream(bad) << "name: bad\neffects:\n  supply_ripple: {dP: 5.0e5, f: -3}\n";
+  const Result failed = run("--scenario " + bad + " --out " + dir + "/never.csv");
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_NE(failed.output.find(bad + ":3:"), std::string::npos) << failed.output;
+  EXPECT_NE(failed.output.find("f"), std::string::npos) << failed.output;
+}
+
+TEST(SimCommand, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run("--preset nope --out /tmp/x.csv").exit_code, 2);
+  EXPECT_EQ(run("--out /tmp/x.csv").exit_code, 2);
+  const Result both = run("--preset healthy --scenario a.yaml --out /tmp/x.csv");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.output.find("exactly one"), std::string::npos) << both.output;
+  const Result help = run("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("paper-fig13"), std::string::npos) << help.output;
+}
+
+}  // namespace
+}  // namespace leakmon
