@@ -150,18 +150,22 @@ void AcquisitionLoop::run(const std::atomic<bool>& stop) noexcept {
     tick.monotonic_ns = next;
     if (!cycle(tick, woke)) break;
 
-    // Keep the phase: the next wake-up is one period after this one's schedule; if we are
-    // already past it, skip the periods we cannot catch up with and count them.
+    // Keep the phase: the next wake-up is one period after this one's schedule. A cycle that
+    // ends after that deadline is an overrun; the loop then starts the next cycle at once (a
+    // late sample is better than a gap). Only when it is a whole period or more behind does it
+    // skip those periods, counted as missed cycles, instead of bunching reads together.
     next += period_ns_;
     ++tick.index;
-    const std::int64_t after = monotonic_now_ns();
-    if (after > next) {
-      const std::int64_t missed = (after - next) / period_ns_ + 1;
+    const std::int64_t late = monotonic_now_ns() - next;
+    if (late > 0) {
       counters_.overruns.fetch_add(1, std::memory_order_relaxed);
-      counters_.missed_cycles.fetch_add(static_cast<std::uint64_t>(missed),
-                                        std::memory_order_relaxed);
-      next += missed * period_ns_;
-      tick.index += static_cast<std::uint64_t>(missed);
+      if (late >= period_ns_) {
+        const std::int64_t missed = late / period_ns_;
+        counters_.missed_cycles.fetch_add(static_cast<std::uint64_t>(missed),
+                                          std::memory_order_relaxed);
+        next += missed * period_ns_;
+        tick.index += static_cast<std::uint64_t>(missed);
+      }
     }
   }
   counters_.running.store(false, std::memory_order_release);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -176,6 +177,13 @@ const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string
   return nullptr;
 }
 
+// Relative paths in a configuration are relative to its file, so that a configuration and its
+// data can move together (and a service's working directory does not matter).
+static std::string resolve_path(const config::ConfigNode& node, const std::string& path) {
+  if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
+  return (std::filesystem::path(node.source()).parent_path() / path).lexically_normal().string();
+}
+
 DaemonConfig parse_config(const config::ConfigNode& root) {
   root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "metrics",
                     "outputs"});
@@ -218,11 +226,11 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
 
   if (auto events = root.find("events")) {
     events->expect_keys({"log"});
-    config.event_log = events->get_string("log", "");
+    config.event_log = resolve_path(*events, events->get_string("log", ""));
   }
   if (auto recording = root.find("recording")) {
     recording->expect_keys({"directory", "rotate_seconds", "keep_files", "flush_seconds"});
-    config.recording.directory = recording->get_string("directory");
+    config.recording.directory = resolve_path(*recording, recording->get_string("directory"));
     config.recording.rotate_seconds = recording->get_double("rotate_seconds", 3600.0, 1.0, 1e7);
     config.recording.keep_files =
         static_cast<std::size_t>(recording->get_int("keep_files", 24, 0, 1000000));

@@ -17,12 +17,12 @@
 namespace leakmon {
 namespace {
 
-struct Run {
+struct Outcome {
   int exit_code;
   std::string output;  // stdout and stderr
 };
 
-Run run_leakmon(const std::string& args, const std::string& dir) {
+Outcome run_leakmon(const std::string& args, const std::string& dir) {
   const std::string log = dir + "/leakmon.log";
   const std::string command = test::leakmon_binary() + " " + args + " > " + log + " 2>&1";
   const int status = std::system(command.c_str());
@@ -63,7 +63,7 @@ TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
   const std::string dir = test::scratch_dir("features_cli_gaps");
   const std::vector<std::size_t> gaps = {450, 451, 1333};
   const auto p1 = write_capture(dir + "/in.csv", 2000, gaps);
-  const Run run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
+  const Outcome run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
                                   "/features.csv",
                               dir);
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -99,7 +99,7 @@ TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
 TEST(FeaturesCli, OptionsChooseWaveletLevelWindowStepAndMode) {
   const std::string dir = test::scratch_dir("features_cli_options");
   const auto p1 = write_capture(dir + "/in.csv", 900, {});
-  const Run run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
+  const Outcome run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
                                   "/f.csv --wavelet sym4 --level 3 --window 256 --step 30 "
                                   "--mode periodization",
                               dir);
@@ -130,7 +130,7 @@ TEST(FeaturesCli, BadOptionsSayWhichAndWhy) {
       {"", "missing required option '--channel'"},
   };
   for (const Bad& bad : cases) {
-    const Run run = run_leakmon(base + bad.args, dir);
+    const Outcome run = run_leakmon(base + bad.args, dir);
     EXPECT_NE(run.exit_code, 0) << bad.args;
     EXPECT_NE(run.output.find(bad.expected), std::string::npos) << bad.args << "\n" << run.output;
   }
@@ -139,7 +139,7 @@ TEST(FeaturesCli, BadOptionsSayWhichAndWhy) {
 TEST(FeaturesCli, MalformedCaptureNamesFileLineAndColumn) {
   const std::string dir = test::scratch_dir("features_cli_malformed");
   std::ofstream(dir + "/bad.csv") << "# leakmon capture v1\nt,p1\n0,1\n0.002,oops\n";
-  const Run run = run_leakmon(
+  const Outcome run = run_leakmon(
       "features --in " + dir + "/bad.csv --channel p1 --out " + dir + "/f.csv", dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find(dir + "/bad.csv:4:2: column 'p1': 'oops' is not a number"),

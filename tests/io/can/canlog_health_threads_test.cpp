@@ -26,9 +26,8 @@ TEST(CanlogHealthThreads, HealthIsSafeToReadWhileReplaying) {
       log << line;  // a one-byte frame (too short) and a bus-off error frame every sample
     }
   }
-  std::ofstream(dir + "/replay.yaml")
-      << "name: replay\ntype: canlog\nfile: bus.log\nsignals:\n"
-         "  - channel: p1\n    id: 0x101\n    length: 16\n";
+  std::ofstream(dir + "/replay.yaml") << "name: replay\ntype: canlog\nfile: bus.log\nsignals:\n"
+                                         "  - channel: p1\n    id: 0x101\n    length: 16\n";
   auto driver = make_canlog_driver(config::ConfigNode::load_file(dir + "/replay.yaml"));
   driver->start();
   std::atomic<bool> done{false};

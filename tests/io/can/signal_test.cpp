@@ -127,7 +127,9 @@ TEST(CanSignal, MatchesTheBitByBitDbcDefinitionForRandomLayouts) {
     encode_reference(s, raw, f);
     std::int64_t expected = static_cast<std::int64_t>(raw);
     if (s.is_signed && s.length < 64 && ((raw >> (s.length - 1)) & 1U)) {
-      expected = static_cast<std::int64_t>(raw) - (std::int64_t{1} << (s.length - 1)) * 2;
+      expected = static_cast<std::int64_t>(raw) -
+                 static_cast<std::int64_t>(std::uint64_t{1} << (s.length - 1)) -
+                 static_cast<std::int64_t>(std::uint64_t{1} << (s.length - 1));
     }
     ASSERT_EQ(extract_raw(s, f), expected)
         << "start " << s.start_bit << " length " << s.length << " order "

@@ -1,0 +1,178 @@
+// The daemon as an operator runs it: a `leakmon run` process replaying a simulated capture with
+// a leak, reloaded with SIGHUP (a valid and an invalid configuration), acknowledged over HTTP,
+// stopped with SIGTERM; then every sample and event is accounted for.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <filesystem>
+#include <regex>
+
+#include "daemon/http_endpoint.hpp"
+#include "io/capture/capture.hpp"
+#include "sim/scenario.hpp"
+#include "sim/simulate.hpp"
+#include "tests/daemon/daemon_process.hpp"
+
+namespace leakmon::daemon {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+int free_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t length = sizeof(addr);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length);
+  ::close(fd);
+  return ntohs(addr.sin_port);
+}
+
+std::string config_text(const std::string& dir, int port, const std::string& alarm) {
+  return "drivers: [{name: bench, type: replay, path: capture.csv}]\n"
+         "actuators:\n"
+         "  - name: cyl\n"
+         "    channels: {p1: p1, p2: p2, u: u, x: x, xref: xref}\n"
+         "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 6}}\n"
+         "    alarm: " + alarm + "\n"
+         "events: {log: events.jsonl}\n"
+         "recording: {directory: rec, rotate_seconds: 10}\n"
+         "metrics: {port: " + std::to_string(port) + "}\n" + (dir.empty() ? "" : "");
+}
+
+void write(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1)) ++n;
+  return n;
+}
+
+TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
+  const std::string dir = test::scratch_dir("daemon_process_lifecycle");
+  constexpr double kOnset = 12.0;
+  sim::Scenario scenario = sim::preset("paper-fig10", 5);
+  scenario.duration_s = 26.0;
+  scenario.effects.internal_leakage->onset_s = kOnset;
+  const io::Capture capture = sim::simulate(scenario);
+  io::write_capture(dir + "/capture.csv", capture);
+
+  const int port = free_port();
+  const std::string cfg = dir + "/leakmon.yaml";
+  write(cfg, config_text(dir, port, "{latching: true}"));
+  test::DaemonProcess daemon({"run", "--config", cfg}, dir + "/daemon.log");
+
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        try {
+          return http_request("127.0.0.1", port, "GET", "/status").status == 200;
+        } catch (const std::exception&) {
+          return false;
+        }
+      },
+      10s))
+      << daemon.log();
+  const auto metrics = http_request("127.0.0.1", port, "GET", "/metrics").body;
+  EXPECT_NE(metrics.find("leakmon_build_info{version="), std::string::npos);
+  EXPECT_NE(metrics.find("leakmon_ring_drops_total{group=\"main\"}"), std::string::npos);
+  EXPECT_NE(metrics.find("leakmon_loop_wakeup_latency_seconds_bucket"), std::string::npos);
+
+  // A valid change applies; a broken file is rejected with its location and changes nothing.
+  const std::string events = dir + "/events.jsonl";
+  write(cfg, config_text(dir, port, "{latching: true, off_delay_s: 2}"));
+  daemon.signal(SIGHUP);
+  ASSERT_TRUE(test::eventually(
+      [&] { return count_of(test::DaemonProcess::read_file(events), "config_reloaded") == 1; }, 10s))
+      << daemon.log();
+  write(cfg, config_text(dir, port, "{latching: true, rasie: 2}"));
+  daemon.signal(SIGHUP);
+  ASSERT_TRUE(test::eventually(
+      [&] { return count_of(test::DaemonProcess::read_file(events), "config_rejected") == 1; }, 10s))
+      << daemon.log();
+  EXPECT_NE(test::DaemonProcess::read_file(events).find("leakmon.yaml:6:29:"), std::string::npos)
+      << "the rejection names file and line";
+  EXPECT_TRUE(daemon.running());
+  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/metrics").body.find(
+                "leakmon_config_reload_success 0"),
+            std::string::npos);
+
+  // The leak raises the (latching) alarm; the operator acknowledges it over HTTP.
+  ASSERT_TRUE(test::eventually(
+      [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_raised") >= 1; }, 25s))
+      << daemon.log();
+  const auto ack = http_request("127.0.0.1", port, "POST", "/ack?actuator=cyl");
+  EXPECT_EQ(ack.status, 200) << ack.body;
+  EXPECT_EQ(http_request("127.0.0.1", port, "POST", "/ack?actuator=nobody").status, 404);
+  ASSERT_TRUE(test::eventually(
+      [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_acknowledged") == 1; },
+      5s));
+
+  daemon.signal(SIGTERM);
+  ASSERT_EQ(daemon.wait(20s), 0) << daemon.log();
+
+  // No alarm before the onset, and the raise carries a leak estimate.
+  std::ifstream lines(events);
+  std::string line;
+  const std::regex raised_t(R"re("t": ([0-9.]+), "event": "alarm_raised")re");
+  while (std::getline(lines, line)) {
+    std::smatch m;
+    if (std::regex_search(line, m, raised_t)) {
+      EXPECT_GT(std::stod(m[1]), kOnset) << line;
+      EXPECT_NE(line.find("\"leak_lpm_per_mpa\""), std::string::npos) << line;
+    }
+  }
+
+  // Every acquired sample was processed and recorded, and the recording replays to the same
+  // samples as the source capture.
+  const std::string log = daemon.log();
+  std::smatch counts;
+  ASSERT_TRUE(std::regex_search(
+      log, counts, std::regex(R"(stopped: (\d+) samples acquired, (\d+) processed, (\d+) dropped)")))
+      << log;
+  const std::uint64_t acquired = std::stoull(counts[1]);
+  EXPECT_GT(acquired, 0u);
+  EXPECT_EQ(std::stoull(counts[2]), acquired);
+  EXPECT_EQ(std::stoull(counts[3]), 0u);
+
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir + "/rec")) files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 1u);
+  std::uint64_t row = 0;
+  for (const auto& file : files) {
+    const io::Capture recorded = io::read_capture(file);
+    for (std::size_t i = 0; i < recorded.rows(); ++i, ++row) {
+      ASSERT_LT(row, capture.rows());
+      ASSERT_EQ(recorded.column("t")[i], capture.column("t")[row]) << file << " row " << i;
+      ASSERT_EQ(recorded.column("p1")[i], capture.column("p1")[row]);
+      ASSERT_EQ(recorded.column("xref")[i], capture.column("xref")[row]);
+    }
+  }
+  EXPECT_EQ(row, acquired);
+}
+
+TEST(DaemonProcess, CheckConfigNamesFileLineAndColumn) {
+  const std::string dir = test::scratch_dir("daemon_process_check_config");
+  write(dir + "/bad.yaml",
+        "drivers: [{name: rig, type: sim, scenario: healthy}]\n"
+        "actuators:\n"
+        "  - name: a\n"
+        "    channels: {p1: rig.p1}\n"
+        "    alarm: {on_delay_s: -3}\n");
+  test::DaemonProcess check({"check-config", dir + "/bad.yaml"}, dir + "/check.log");
+  EXPECT_EQ(check.wait(30s), 1);
+  EXPECT_NE(check.log().find("bad.yaml:5:"), std::string::npos) << check.log();
+  EXPECT_NE(check.log().find("on_delay_s"), std::string::npos) << check.log();
+
+  test::DaemonProcess good({"check-config", test::source_dir() + "/config/demo.yaml"},
+                           dir + "/good.log");
+  EXPECT_EQ(good.wait(30s), 0) << good.log();
+}
+
+}  // namespace
+}  // namespace leakmon::daemon

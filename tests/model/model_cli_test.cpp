@@ -1,0 +1,77 @@
+// `leakmon model check` as a user runs it: JSON of FORMATS.md, the report with plots, and
+// clear errors for unusable captures.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "io/capture/capture.hpp"
+#include "model/synthetic_case.hpp"
+#include "tests/model/test_seed.hpp"
+#include "tests/support/paths.hpp"
+
+namespace leakmon::model {
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int run(const std::string& args, const std::string& log) {
+  const std::string command = test::leakmon_binary() + " " + args + " > " + log + " 2>&1";
+  return std::system(command.c_str());
+}
+
+TEST(ModelCli, ChecksACaptureAndWritesJsonAndReport) {
+  const auto seed = test::model_test_seed("ModelCli.ChecksACaptureAndWritesJsonAndReport");
+  const std::string dir = test::scratch_dir("model_cli_check");
+  const SyntheticCase c = draw_case(seed, "internal_leakage", {40.0});
+  io::write_capture(dir + "/capture.csv", simulate_case(c));
+  ASSERT_EQ(run("model check --data " + dir + "/capture.csv --json " + dir +
+                    "/result.json --report " + dir + "/report",
+                dir + "/log.txt"),
+            0)
+      << read_file(dir + "/log.txt");
+  // The JSON is read back by Python's parser, the way other tools consume it.
+  const std::string check = test::python() +
+                            " -c \"import json,sys; r=json.load(open(sys.argv[1])); "
+                            "assert r['cause']=='internal_leakage', r['cause']; "
+                            "assert abs(r['params']['C_L']/" +
+                            std::to_string(c.main_value) +
+                            "-1)<0.25; "
+                            "assert set(r['calibrated'])=={'beta','Kv','m','b'}; "
+                            "assert len(r['ranking'])==11; "
+                            "assert r['nrmse_after']<r['nrmse_before']\" " +
+                            dir + "/result.json";
+  EXPECT_EQ(std::system(check.c_str()), 0) << read_file(dir + "/result.json");
+  const std::string report = read_file(dir + "/report/report.md");
+  EXPECT_NE(report.find("internal_leakage"), std::string::npos);
+  for (const char* png : {"residuals_time.png", "residuals_regressors.png",
+                          "residuals_spectrum.png"}) {
+    EXPECT_GT(std::filesystem::file_size(dir + "/report/" + png), 10000u) << png;
+  }
+}
+
+TEST(ModelCli, RefusesACaptureWithoutPressures) {
+  const std::string dir = test::scratch_dir("model_cli_columns");
+  {
+    std::ofstream out(dir + "/capture.csv");
+    out << "t,u,x\n0,0,0\n0.002,0,0\n";
+  }
+  EXPECT_NE(run("model check --data " + dir + "/capture.csv --json " + dir + "/r.json",
+                dir + "/log.txt"),
+            0);
+  const std::string log = read_file(dir + "/log.txt");
+  EXPECT_NE(log.find(dir + "/capture.csv"), std::string::npos) << log;
+  EXPECT_NE(log.find("'p1', 'p2'"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/r.json"));
+}
+
+}  // namespace
+}  // namespace leakmon::model

@@ -1,0 +1,118 @@
+// The model check's own actuator model against the simulator's plant (two implementations of
+// MODEL.md must give the same trajectories), and calibration on simulated "measured" data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "model/actuator_model.hpp"
+#include "model/calibration_fit.hpp"
+#include "model/measured_record.hpp"
+#include "model/synthetic_case.hpp"
+#include "sim/plant.hpp"
+#include "tests/model/test_seed.hpp"
+
+namespace leakmon::model {
+namespace {
+
+struct Variant {
+  std::string name;
+  sim::Effects sim_effects;
+  EffectParameters effects;
+};
+
+std::vector<Variant> variants() {
+  std::vector<Variant> out;
+  out.push_back({"nominal", {}, {}});
+  Variant v;
+  v = {"internal_leakage", {}, {}};
+  v.sim_effects.internal_leakage = sim::InternalLeakage{3e-12};
+  v.effects.C_L = 3e-12;
+  out.push_back(v);
+  v = {"external_leakage", {}, {}};
+  v.sim_effects.external_leakage = sim::ExternalLeakage{1e-12, 2};
+  v.effects.C_E = 1e-12;
+  v.effects.external_chamber = 2;
+  out.push_back(v);
+  v = {"entrained_air", {}, {}};
+  v.sim_effects.entrained_air = sim::EntrainedAir{0.1};
+  v.effects.alpha = 0.1;
+  out.push_back(v);
+  v = {"valve_overlap", {}, {}};
+  v.sim_effects.valve_overlap = sim::ValveOverlap{0.03};
+  v.effects.d = 0.03;
+  out.push_back(v);
+  v = {"valve_bias", {}, {}};
+  v.sim_effects.valve_bias = sim::ValveBias{-0.2};
+  v.effects.u0 = -0.2;
+  out.push_back(v);
+  v = {"spool_lag", {}, {}};
+  v.sim_effects.spool_lag = sim::SpoolLag{0.01};
+  v.effects.spool_tau = 0.01;
+  out.push_back(v);
+  v = {"supply_ripple", {}, {}};
+  v.sim_effects.supply_ripple = sim::SupplyRipple{8e5, 90.0};
+  v.effects.ripple_dP = 8e5;
+  v.effects.ripple_f = 90.0;
+  out.push_back(v);
+  v = {"supply_droop", {}, {}};
+  v.sim_effects.supply_droop = sim::SupplyDroop{2e10};
+  v.effects.R_s = 2e10;
+  out.push_back(v);
+  v = {"sensor_lag", {}, {}};
+  v.sim_effects.sensor_lag = sim::SensorLag{0.008, sim::PressureChannel::p2};
+  v.effects.tau_s = 0.008;
+  v.effects.lag_channel = PressureChannel::p2;
+  out.push_back(v);
+  return out;
+}
+
+// Open loop from rest under a slow sinusoidal command, noise off: both implementations of
+// MODEL.md must agree to well below the sensor noise.
+TEST(ActuatorModel, MatchesTheSimulatorsPlantForEveryEffect) {
+  for (const auto& variant : variants()) {
+    sim::Parameters sp = sim::Parameters::nominal();
+    sp.sigma_w = 0.0;
+    sim::Plant plant(sp, variant.sim_effects, 1);
+    plant.reset();
+    ModelParameters mp;
+    mp.effects = variant.effects;
+    const ActuatorModel model(mp);
+    ActuatorState s;
+    s.p1 = s.p2 = s.s = (17.2e6 + 0.1e6) / 2.0;
+    const double dt = 0.002;
+    double worst_x = 0.0, worst_p = 0.0;
+    for (int k = 0; k < 500; ++k) {
+      const double t = k * dt;
+      const double u = 1.5 * std::sin(2.0 * 3.14159265358979 * 1.5 * t);
+      plant.advance(u, t, dt);
+      model.advance(s, u, t, dt);
+      const Reading r = model.read(s);
+      worst_x = std::max(worst_x, std::abs(r.x - plant.state().x));
+      worst_p = std::max(worst_p, std::abs(r.p1 - plant.state().p1_transducer));
+      worst_p = std::max(worst_p, std::abs(r.p2 - plant.state().p2_transducer));
+    }
+    EXPECT_LT(worst_x, 5e-6) << variant.name;  // position noise is 5 um
+    EXPECT_LT(worst_p, 5e3) << variant.name;   // pressure noise is 5 kPa
+  }
+}
+
+TEST(Calibration, RecoversPerturbedParametersFromNoisyData) {
+  const auto seed = test::model_test_seed("Calibration.RecoversPerturbedParametersFromNoisyData");
+  const SyntheticCase c = draw_case(seed, "none", {24.0});
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const SegmentPredictor predictor(record);
+  const auto segments = spread(split_record(record).fitting, 16);
+  const FitResult fit = fit_model(predictor, segments, nullptr, Calibration{});
+  const auto& truth = c.scenario.params;
+  EXPECT_NEAR(fit.parameters.calibration.Kv, truth.Kv, 0.03 * truth.Kv);
+  EXPECT_NEAR(fit.parameters.calibration.b, truth.b, 0.15 * truth.b);
+  EXPECT_NEAR(fit.parameters.calibration.m, truth.m, 0.15 * truth.m);
+  EXPECT_NEAR(fit.parameters.calibration.beta, truth.beta, 0.25 * truth.beta);
+  // The calibrated nominal model predicts the held-out part to within the noise.
+  const auto held_out = spread(split_record(record).held_out, 16);
+  EXPECT_LT(predictor.nrmse(fit.parameters, held_out), 0.02);
+}
+
+}  // namespace
+}  // namespace leakmon::model
