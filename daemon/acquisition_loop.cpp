@@ -43,9 +43,10 @@ std::int64_t monotonic_now_ns() noexcept {
 
 std::string lock_process_memory() {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    return fmt::format("mlockall failed ({}): pages may fault in the real-time loop; grant "
-                       "CAP_IPC_LOCK or raise LimitMEMLOCK",
-                       std::strerror(errno));
+    return fmt::format(
+        "mlockall failed ({}): pages may fault in the real-time loop; grant "
+        "CAP_IPC_LOCK or raise LimitMEMLOCK",
+        std::strerror(errno));
   }
   return {};
 }

@@ -20,16 +20,16 @@
 namespace leakmon::daemon {
 
 struct LoopCounters {
-  std::atomic<std::uint64_t> cycles{0};         // cycles run (ticks minus missed)
+  std::atomic<std::uint64_t> cycles{0};  // cycles run (ticks minus missed)
   std::atomic<std::uint64_t> samples_pushed{0};
-  std::atomic<std::uint64_t> ring_drops{0};     // samples lost because the ring was full
+  std::atomic<std::uint64_t> ring_drops{0};  // samples lost because the ring was full
   std::atomic<std::uint64_t> ring_high_water{0};
   std::atomic<std::uint64_t> overruns{0};       // late wake-ups that skipped a period
   std::atomic<std::uint64_t> missed_cycles{0};  // periods skipped by those overruns
   std::atomic<std::int64_t> last_cycle_ns{0};   // CLOCK_MONOTONIC of the newest cycle (watchdog)
   std::atomic<bool> running{false};
-  std::atomic<bool> end_of_stream{false};       // a finite driver (replay) ran out
-  LatencyHistogram wakeup_latency;              // actual minus scheduled wake-up
+  std::atomic<bool> end_of_stream{false};  // a finite driver (replay) ran out
+  LatencyHistogram wakeup_latency;         // actual minus scheduled wake-up
 };
 
 // What the real-time setup achieved; the messages are logged once, at start-up.
@@ -51,8 +51,7 @@ std::int64_t monotonic_now_ns() noexcept;
 class AcquisitionLoop {
  public:
   // `drivers` must outlive the loop; their channels are laid out in this order in Sample.
-  AcquisitionLoop(std::int64_t period_ns, std::vector<io::Driver*> drivers,
-                  SpscRing<Sample>& ring);
+  AcquisitionLoop(std::int64_t period_ns, std::vector<io::Driver*> drivers, SpscRing<Sample>& ring);
 
   std::int64_t period_ns() const { return period_ns_; }
   std::size_t channel_count() const { return channel_count_; }

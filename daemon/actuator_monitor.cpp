@@ -28,8 +28,7 @@ std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
   signals.x = layout.x >= 0;
   const double hop_seconds =
       static_cast<double>(config.features.step) * static_cast<double>(period_ns) / 1e9;
-  const config::ConfigNode* options =
-      config.detector_options ? &*config.detector_options : nullptr;
+  const config::ConfigNode* options = config.detector_options ? &*config.detector_options : nullptr;
   return detect::make_detector(config.detector, signals, hop_seconds, options);
 }
 

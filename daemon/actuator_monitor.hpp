@@ -30,8 +30,8 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
-  double t = kNoValue;          // source time of the newest decision
-  double index_p1 = kNoValue;   // Pa
+  double t = kNoValue;         // source time of the newest decision
+  double index_p1 = kNoValue;  // Pa
   double index_p2 = kNoValue;
   double score = kNoValue;
   double baseline = kNoValue;

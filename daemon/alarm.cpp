@@ -4,10 +4,14 @@ namespace leakmon::daemon {
 
 std::string_view to_string(AlarmState state) {
   switch (state) {
-    case AlarmState::normal: return "normal";
-    case AlarmState::active_unacknowledged: return "active_unacknowledged";
-    case AlarmState::active_acknowledged: return "active_acknowledged";
-    case AlarmState::returned_unacknowledged: return "returned_unacknowledged";
+    case AlarmState::normal:
+      return "normal";
+    case AlarmState::active_unacknowledged:
+      return "active_unacknowledged";
+    case AlarmState::active_acknowledged:
+      return "active_acknowledged";
+    case AlarmState::returned_unacknowledged:
+      return "returned_unacknowledged";
   }
   return "unknown";
 }
@@ -18,10 +22,10 @@ AlarmTransition Alarm::update(double score, double t) {
   AlarmTransition transition;
   if (std::isnan(score)) return transition;
 
-  above_since_ = score >= settings_.raise_threshold ? (std::isnan(above_since_) ? t : above_since_)
-                                                    : NAN;
-  below_since_ = score <= settings_.clear_threshold ? (std::isnan(below_since_) ? t : below_since_)
-                                                    : NAN;
+  above_since_ =
+      score >= settings_.raise_threshold ? (std::isnan(above_since_) ? t : above_since_) : NAN;
+  below_since_ =
+      score <= settings_.clear_threshold ? (std::isnan(below_since_) ? t : below_since_) : NAN;
   if (!condition_ && !std::isnan(above_since_) && t - above_since_ >= settings_.on_delay_s) {
     condition_ = true;
   } else if (condition_ && !std::isnan(below_since_) && t - below_since_ >= settings_.off_delay_s) {

@@ -56,7 +56,7 @@ class Alarm {
  private:
   AlarmSettings settings_;
   AlarmState state_ = AlarmState::normal;
-  bool condition_ = false;  // the delayed, deadbanded condition
+  bool condition_ = false;    // the delayed, deadbanded condition
   double above_since_ = NAN;  // first time of the current run of score >= raise
   double below_since_ = NAN;  // first time of the current run of score <= clear
 };

@@ -25,8 +25,10 @@ CaptureRecorder::~CaptureRecorder() { close(); }
 void CaptureRecorder::open(double t) {
   if (writer_) writer_->close();
   const auto now = std::chrono::system_clock::now();
-  const auto stamp = fmt::format("{:%Y%m%dT%H%M%S}", fmt::gmtime(std::chrono::system_clock::to_time_t(now)));
-  std::string path = (fs::path(config_.directory) / fmt::format("{}-{}.csv", group_, stamp)).string();
+  const auto stamp =
+      fmt::format("{:%Y%m%dT%H%M%S}", fmt::gmtime(std::chrono::system_clock::to_time_t(now)));
+  std::string path =
+      (fs::path(config_.directory) / fmt::format("{}-{}.csv", group_, stamp)).string();
   for (int n = 1; fs::exists(path); ++n) {
     path = (fs::path(config_.directory) / fmt::format("{}-{}-{}.csv", group_, stamp, n)).string();
   }

@@ -3,15 +3,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
-#include "daemon/sample.hpp"
-#include "detect/factory.hpp"
 #include "daemon/driver_registry.hpp"
 #include "daemon/output_registry.hpp"
+#include "daemon/sample.hpp"
+#include "detect/factory.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -21,8 +21,8 @@ std::string checked_name(const config::ConfigNode& node, std::set<std::string>& 
   const auto name_node = node.at("name");
   const std::string name = name_node.as_string();
   if (name.empty() || name.find_first_of(". \t/") != std::string::npos) {
-    name_node.fail(fmt::format("{} name '{}' must be non-empty, without '.', '/' or spaces", what,
-                               name));
+    name_node.fail(
+        fmt::format("{} name '{}' must be non-empty, without '.', '/' or spaces", what, name));
   }
   if (!seen.insert(name).second) name_node.fail(fmt::format("duplicate {} name '{}'", what, name));
   return name;
@@ -35,9 +35,10 @@ ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig&
   ref.where = node;
   if (dot == std::string::npos) {
     if (config.drivers.size() != 1) {
-      node.fail(fmt::format("'{}': name the driver as 'driver.channel' when there are several "
-                            "drivers",
-                            text));
+      node.fail(
+          fmt::format("'{}': name the driver as 'driver.channel' when there are several "
+                      "drivers",
+                      text));
     }
     ref.driver = config.drivers.front().name;
     ref.channel = text;
@@ -83,9 +84,10 @@ AlarmSettings parse_alarm(const config::ConfigNode& node) {
   if (node.has("clear")) alarm.clear_threshold = node.get_double("clear", -1e9, 1e9);
   if (!std::isnan(alarm.raise_threshold) && !std::isnan(alarm.clear_threshold) &&
       alarm.clear_threshold >= alarm.raise_threshold) {
-    node.at("clear").fail(fmt::format("clear threshold {} must be below the raise threshold {} "
-                                      "(the deadband)",
-                                      alarm.clear_threshold, alarm.raise_threshold));
+    node.at("clear").fail(
+        fmt::format("clear threshold {} must be below the raise threshold {} "
+                    "(the deadband)",
+                    alarm.clear_threshold, alarm.raise_threshold));
   }
   alarm.on_delay_s = node.get_double("on_delay_s", 0.0, 0.0, 86400.0);
   alarm.off_delay_s = node.get_double("off_delay_s", 0.0, 0.0, 86400.0);
@@ -109,9 +111,10 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
   for (const auto* ref : {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
     if (ref->present() && group_of_driver(config, ref->driver) != group) {
-      channels.fail(fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
-                                "actuator's channels must come from one sampling group",
-                                ref->text(), actuator.p1.text()));
+      channels.fail(
+          fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
+                      "actuator's channels must come from one sampling group",
+                      ref->text(), actuator.p1.text()));
     }
   }
   if (auto features = node.find("features")) actuator.features = parse_features(*features);
@@ -148,8 +151,8 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
       node.get_int("ring_capacity", static_cast<long long>(group.ring_capacity), 16, 1 << 22));
   if (auto cpus = node.find("cpus")) {
     for (const auto& cpu : cpus->items()) {
-      group.cpus.push_back(static_cast<int>(cpu.check_range(static_cast<double>(cpu.as_int()), 0,
-                                                            1023)));
+      group.cpus.push_back(
+          static_cast<int>(cpu.check_range(static_cast<double>(cpu.as_int()), 0, 1023)));
     }
   }
   for (const auto& item : node.at("drivers").items()) {
@@ -185,8 +188,8 @@ static std::string resolve_path(const config::ConfigNode& node, const std::strin
 }
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
-  root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "metrics",
-                    "outputs"});
+  root.expect_keys(
+      {"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs"});
   DaemonConfig config;
   config.source = root.source();
 
@@ -277,9 +280,8 @@ void check_channels(const DaemonConfig& config,
       if (!ref->present()) continue;
       const auto& names = channels_of(ref->driver);
       if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;
-      const std::string message =
-          fmt::format("driver '{}' has no channel '{}' (it has: {})", ref->driver, ref->channel,
-                      fmt::join(names, ", "));
+      const std::string message = fmt::format("driver '{}' has no channel '{}' (it has: {})",
+                                              ref->driver, ref->channel, fmt::join(names, ", "));
       if (ref->where) ref->where->fail(message);
       throw config::ConfigError(fmt::format("{}: {}", config.source, message));
     }

@@ -54,9 +54,9 @@ struct ActuatorConfig {
 };
 
 struct RecordingConfig {
-  std::string directory;            // empty: no recording
-  double rotate_seconds = 3600.0;   // start a new file after this much source time
-  std::size_t keep_files = 24;      // oldest files beyond this are deleted; 0 keeps all
+  std::string directory;           // empty: no recording
+  double rotate_seconds = 3600.0;  // start a new file after this much source time
+  std::size_t keep_files = 24;     // oldest files beyond this are deleted; 0 keeps all
   double flush_seconds = 1.0;
 };
 
@@ -74,8 +74,9 @@ struct DaemonConfig {
   RecordingConfig recording;
   MetricsConfig metrics;
   std::vector<config::ConfigNode> outputs;
-  // Worker wake-up interval when the rings are empty [ns].
-  std::int64_t worker_poll_ns = 2'000'000;
+  // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency
+  // (target p99 < 1 ms) at the cost of 2000 cheap wake-ups a second.
+  std::int64_t worker_poll_ns = 500'000;
 };
 
 // Parses and validates; throws config::ConfigError with `file:line:column: path: message`.

@@ -40,7 +40,8 @@ std::string yaml_text(const std::optional<config::ConfigNode>& node) {
 // What a reload cannot change without restarting acquisition.
 std::string acquisition_signature(const DaemonConfig& config) {
   std::string text;
-  for (const auto& d : config.drivers) text += fmt::format("driver {}\n{}\n", d.name, yaml_text(d.node));
+  for (const auto& d : config.drivers)
+    text += fmt::format("driver {}\n{}\n", d.name, yaml_text(d.node));
   for (const auto& g : config.groups) {
     text += fmt::format("group {} {} {} {} [{}] [{}]\n", g.name, g.period_ns, g.priority,
                         g.ring_capacity, fmt::join(g.drivers, ","), fmt::join(g.cpus, ","));
@@ -103,9 +104,8 @@ std::vector<EventSink*> Daemon::raw(const std::vector<std::unique_ptr<EventSink>
 
 void Daemon::start() {
   config_ = check_config(config_path_);
-  spdlog::info("configuration {}: {} driver(s), {} sampling group(s), {} actuator(s)",
-               config_path_, config_.drivers.size(), config_.groups.size(),
-               config_.actuators.size());
+  spdlog::info("configuration {}: {} driver(s), {} sampling group(s), {} actuator(s)", config_path_,
+               config_.drivers.size(), config_.groups.size(), config_.actuators.size());
 
   // Threads inherit the blocked control signals: only the main thread receives them.
   const sigset_t signals = control_signals();
@@ -141,8 +141,8 @@ void Daemon::start() {
     group->ring = std::make_unique<SpscRing<Sample>>(group_config.ring_capacity);
     group->loop =
         std::make_unique<AcquisitionLoop>(group_config.period_ns, group->drivers, *group->ring);
-    inputs.push_back(GroupInput{group_config.name, group->ring.get(), channels,
-                                group_config.period_ns});
+    inputs.push_back(
+        GroupInput{group_config.name, group->ring.get(), channels, group_config.period_ns});
     groups_.push_back(std::move(group));
   }
   reported_overruns_.assign(groups_.size(), 0);
@@ -205,8 +205,8 @@ void Daemon::stop() {
     pushed += group->loop->counters().samples_pushed.load();
     drops += group->loop->counters().ring_drops.load();
   }
-  spdlog::info("stopped: {} samples acquired, {} processed, {} dropped, {} events",
-               pushed, worker_->samples_processed(), drops, worker_->events_published());
+  spdlog::info("stopped: {} samples acquired, {} processed, {} dropped, {} events", pushed,
+               worker_->samples_processed(), drops, worker_->events_published());
   worker_.reset();
   sinks_.clear();
 }
@@ -245,9 +245,9 @@ void Daemon::housekeeping(std::int64_t now_ns) {
       Event event;
       event.kind = EventKind::overrun;
       event.channel = groups_[i]->config.name;
-      event.message = fmt::format("{} overrun(s), {} missed cycle(s) in total, {} ring drop(s)",
-                                  overruns, counters.missed_cycles.load(),
-                                  counters.ring_drops.load());
+      event.message =
+          fmt::format("{} overrun(s), {} missed cycle(s) in total, {} ring drop(s)", overruns,
+                      counters.missed_cycles.load(), counters.ring_drops.load());
       worker_->publish(event);
       reported_overruns_[i] = overruns;
       last_overrun_warning_ns_ = now_ns;
@@ -315,8 +315,8 @@ int Daemon::run() {
 
   const sigset_t signals = control_signals();
   const std::int64_t watchdog_ns = notifier_.watchdog_interval().count() * 1000;
-  const std::int64_t wait_ns = watchdog_ns > 0 ? std::min<std::int64_t>(kSecond / 4, watchdog_ns / 4)
-                                               : kSecond / 4;
+  const std::int64_t wait_ns =
+      watchdog_ns > 0 ? std::min<std::int64_t>(kSecond / 4, watchdog_ns / 4) : kSecond / 4;
   while (true) {
     const timespec timeout{0, static_cast<long>(wait_ns)};
     const int signal = sigtimedwait(&signals, nullptr, &timeout);
@@ -337,8 +337,10 @@ int Daemon::run() {
 }
 
 HttpResponse Daemon::handle(const HttpRequest& request) {
-  if (request.path == "/metrics" && request.method == "GET") return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
-  if (request.path == "/status" && request.method == "GET") return {200, "text/plain; charset=utf-8", status_text()};
+  if (request.path == "/metrics" && request.method == "GET")
+    return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
+  if (request.path == "/status" && request.method == "GET")
+    return {200, "text/plain; charset=utf-8", status_text()};
   if (request.path == "/ack") {
     if (request.method != "POST") return {405, "text/plain", "use POST /ack?actuator=NAME\n"};
     std::string actuator;
@@ -355,11 +357,13 @@ std::string Daemon::metrics_text() const {
   out += "# HELP leakmon_build_info leakmon version\n# TYPE leakmon_build_info gauge\n";
   out += fmt::format("leakmon_build_info{{version=\"{}\"}} 1\n", LEAKMON_VERSION);
 
-  out += "# HELP leakmon_loop_wakeup_latency_seconds acquisition loop wake-up minus schedule\n"
-         "# TYPE leakmon_loop_wakeup_latency_seconds histogram\n";
+  out +=
+      "# HELP leakmon_loop_wakeup_latency_seconds acquisition loop wake-up minus schedule\n"
+      "# TYPE leakmon_loop_wakeup_latency_seconds histogram\n";
   for (const auto& g : groups_) {
     histogram(out, "leakmon_loop_wakeup_latency_seconds",
-              fmt::format("group=\"{}\"", label(g->config.name)), g->loop->counters().wakeup_latency);
+              fmt::format("group=\"{}\"", label(g->config.name)),
+              g->loop->counters().wakeup_latency);
   }
   auto counter = [&](std::string_view name, std::string_view help, std::string_view type,
                      auto value_of) {
@@ -383,46 +387,53 @@ std::string Daemon::metrics_text() const {
   counter("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
           [](const Group& g) { return g.realtime.fifo ? 1 : 0; });
 
-  out += "# HELP leakmon_samples_processed_total samples the worker consumed\n"
-         "# TYPE leakmon_samples_processed_total counter\n";
+  out +=
+      "# HELP leakmon_samples_processed_total samples the worker consumed\n"
+      "# TYPE leakmon_samples_processed_total counter\n";
   out += fmt::format("leakmon_samples_processed_total {}\n", worker_->samples_processed());
   out += "# HELP leakmon_events_total events published\n# TYPE leakmon_events_total counter\n";
   out += fmt::format("leakmon_events_total {}\n", worker_->events_published());
-  out += "# HELP leakmon_decision_latency_seconds sample acquisition to decision and events\n"
-         "# TYPE leakmon_decision_latency_seconds histogram\n";
+  out +=
+      "# HELP leakmon_decision_latency_seconds sample acquisition to decision and events\n"
+      "# TYPE leakmon_decision_latency_seconds histogram\n";
   histogram(out, "leakmon_decision_latency_seconds", "", worker_->decision_latency());
 
   const auto actuators = worker_->status();
-  out += "# HELP leakmon_index_pascal newest wavelet index (db8 level-2 detail RMS)\n"
-         "# TYPE leakmon_index_pascal gauge\n";
+  out +=
+      "# HELP leakmon_index_pascal newest wavelet index (db8 level-2 detail RMS)\n"
+      "# TYPE leakmon_index_pascal gauge\n";
   for (const auto& a : actuators) {
-    out += fmt::format("leakmon_index_pascal{{actuator=\"{}\",channel=\"p1\"}} {}\n",
-                       label(a.name), number(a.index_p1));
+    out += fmt::format("leakmon_index_pascal{{actuator=\"{}\",channel=\"p1\"}} {}\n", label(a.name),
+                       number(a.index_p1));
     if (std::isfinite(a.index_p2)) {
       out += fmt::format("leakmon_index_pascal{{actuator=\"{}\",channel=\"p2\"}} {}\n",
                          label(a.name), number(a.index_p2));
     }
   }
-  out += "# HELP leakmon_detector_score newest detector score\n# TYPE leakmon_detector_score gauge\n";
+  out +=
+      "# HELP leakmon_detector_score newest detector score\n# TYPE leakmon_detector_score gauge\n";
   for (const auto& a : actuators) {
     out += fmt::format("leakmon_detector_score{{actuator=\"{}\",detector=\"{}\"}} {}\n",
                        label(a.name), label(a.detector), number(a.score));
   }
-  out += "# HELP leakmon_detector_learning 1 while the detector learns the healthy baseline\n"
-         "# TYPE leakmon_detector_learning gauge\n";
+  out +=
+      "# HELP leakmon_detector_learning 1 while the detector learns the healthy baseline\n"
+      "# TYPE leakmon_detector_learning gauge\n";
   for (const auto& a : actuators) {
     out += fmt::format("leakmon_detector_learning{{actuator=\"{}\"}} {}\n", label(a.name),
                        a.learning ? 1 : 0);
   }
-  out += "# HELP leakmon_alarm_active 1 while the alarm is annunciated\n"
-         "# TYPE leakmon_alarm_active gauge\n";
+  out +=
+      "# HELP leakmon_alarm_active 1 while the alarm is annunciated\n"
+      "# TYPE leakmon_alarm_active gauge\n";
   for (const auto& a : actuators) {
     out += fmt::format("leakmon_alarm_active{{actuator=\"{}\",alarm=\"{}\",state=\"{}\"}} {}\n",
                        label(a.name), label(a.alarm), to_string(a.state),
                        a.state == AlarmState::normal ? 0 : 1);
   }
-  out += "# HELP leakmon_driver_errors_total driver communication errors\n"
-         "# TYPE leakmon_driver_errors_total counter\n";
+  out +=
+      "# HELP leakmon_driver_errors_total driver communication errors\n"
+      "# TYPE leakmon_driver_errors_total counter\n";
   std::string up, reconnects, stale;
   for (const auto& d : drivers_) {
     const auto health = d->health();
@@ -435,27 +446,42 @@ std::string Daemon::metrics_text() const {
     stale += fmt::format("leakmon_driver_stale_values_total{{driver=\"{}\"}} {}\n",
                          label(d->name()), health.stale_values);
   }
-  out += "# HELP leakmon_driver_up 1 when the driver reports state ok\n# TYPE leakmon_driver_up gauge\n" + up;
-  out += "# HELP leakmon_driver_reconnects_total driver reconnects\n# TYPE leakmon_driver_reconnects_total counter\n" + reconnects;
-  out += "# HELP leakmon_driver_stale_values_total reads that gave a gap because the value was too old\n# TYPE leakmon_driver_stale_values_total counter\n" + stale;
+  out +=
+      "# HELP leakmon_driver_up 1 when the driver reports state ok\n# TYPE leakmon_driver_up "
+      "gauge\n" +
+      up;
+  out +=
+      "# HELP leakmon_driver_reconnects_total driver reconnects\n# TYPE "
+      "leakmon_driver_reconnects_total counter\n" +
+      reconnects;
+  out +=
+      "# HELP leakmon_driver_stale_values_total reads that gave a gap because the value was too "
+      "old\n# TYPE leakmon_driver_stale_values_total counter\n" +
+      stale;
 
-  out += "# HELP leakmon_config_reload_success 1 when the last reload (or start) succeeded\n"
-         "# TYPE leakmon_config_reload_success gauge\n";
+  out +=
+      "# HELP leakmon_config_reload_success 1 when the last reload (or start) succeeded\n"
+      "# TYPE leakmon_config_reload_success gauge\n";
   out += fmt::format("leakmon_config_reload_success {}\n", last_reload_ok_.load() ? 1 : 0);
-  out += "# HELP leakmon_config_reloads_total reloads applied\n# TYPE leakmon_config_reloads_total counter\n";
+  out +=
+      "# HELP leakmon_config_reloads_total reloads applied\n# TYPE leakmon_config_reloads_total "
+      "counter\n";
   out += fmt::format("leakmon_config_reloads_total {}\n", reloads_.load());
-  out += "# HELP leakmon_config_reload_failures_total reloads rejected\n# TYPE leakmon_config_reload_failures_total counter\n";
+  out +=
+      "# HELP leakmon_config_reload_failures_total reloads rejected\n# TYPE "
+      "leakmon_config_reload_failures_total counter\n";
   out += fmt::format("leakmon_config_reload_failures_total {}\n", reload_failures_.load());
-  out += "# HELP leakmon_config_last_reload_timestamp_seconds unix time of the last reload attempt\n"
-         "# TYPE leakmon_config_last_reload_timestamp_seconds gauge\n";
+  out +=
+      "# HELP leakmon_config_last_reload_timestamp_seconds unix time of the last reload attempt\n"
+      "# TYPE leakmon_config_last_reload_timestamp_seconds gauge\n";
   out += fmt::format("leakmon_config_last_reload_timestamp_seconds {}\n", last_reload_unix_.load());
   return out;
 }
 
 std::string Daemon::status_text() const {
-  std::string out = fmt::format("leakmon {} running {:.0f} s, configuration {}\n", LEAKMON_VERSION,
-                                static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9,
-                                config_path_);
+  std::string out =
+      fmt::format("leakmon {} running {:.0f} s, configuration {}\n", LEAKMON_VERSION,
+                  static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9, config_path_);
   out += fmt::format("last reload: {}\n", last_reload_ok_.load() ? "ok" : "REJECTED (see log)");
   for (const auto& g : groups_) {
     const auto& c = g->loop->counters();
@@ -464,8 +490,8 @@ std::string Daemon::status_text() const {
         "{} ring drops (high water {}/{}), {}\n",
         g->config.name, c.cycles.load(), c.wakeup_latency.mean_ns() / 1e3,
         static_cast<double>(c.wakeup_latency.max_ns()) / 1e3, c.overruns.load(),
-        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(),
-        g->ring->capacity(), g->realtime.fifo ? "SCHED_FIFO" : "normal scheduling");
+        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(), g->ring->capacity(),
+        g->realtime.fifo ? "SCHED_FIFO" : "normal scheduling");
   }
   for (const auto& d : drivers_) {
     const auto health = d->health();
@@ -473,10 +499,11 @@ std::string Daemon::status_text() const {
                        health.last_error.empty() ? "" : ": ", health.last_error, health.errors);
   }
   for (const auto& a : worker_->status()) {
-    out += fmt::format("actuator {}: alarm {} {}, index p1 {:.2f} kPa, score {:.3g}, baseline {:.2f} "
-                       "kPa{}, detector {}, t {:.2f} s\n",
-                       a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score,
-                       a.baseline / 1e3, a.learning ? " (learning)" : "", a.detector, a.t);
+    out += fmt::format(
+        "actuator {}: alarm {} {}, index p1 {:.2f} kPa, score {:.3g}, baseline {:.2f} "
+        "kPa{}, detector {}, t {:.2f} s\n",
+        a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score, a.baseline / 1e3,
+        a.learning ? " (learning)" : "", a.detector, a.t);
   }
   return out;
 }

@@ -24,14 +24,22 @@ enum class EventKind {
 
 constexpr std::string_view to_string(EventKind kind) {
   switch (kind) {
-    case EventKind::alarm_raised: return "alarm_raised";
-    case EventKind::alarm_cleared: return "alarm_cleared";
-    case EventKind::alarm_acknowledged: return "alarm_acknowledged";
-    case EventKind::driver_fault: return "driver_fault";
-    case EventKind::driver_recovered: return "driver_recovered";
-    case EventKind::overrun: return "overrun";
-    case EventKind::config_reloaded: return "config_reloaded";
-    case EventKind::config_rejected: return "config_rejected";
+    case EventKind::alarm_raised:
+      return "alarm_raised";
+    case EventKind::alarm_cleared:
+      return "alarm_cleared";
+    case EventKind::alarm_acknowledged:
+      return "alarm_acknowledged";
+    case EventKind::driver_fault:
+      return "driver_fault";
+    case EventKind::driver_recovered:
+      return "driver_recovered";
+    case EventKind::overrun:
+      return "overrun";
+    case EventKind::config_reloaded:
+      return "config_reloaded";
+    case EventKind::config_rejected:
+      return "config_rejected";
   }
   return "unknown";
 }
@@ -43,11 +51,11 @@ struct Event {
   // Source time of the sample that completed the deciding window [s] (the capture's t under
   // replay, seconds since the group started otherwise); NaN for events not tied to a sample.
   double t = kNoValue;
-  std::string actuator;  // empty for daemon-wide events
-  std::string alarm;     // "internal_leakage" for alarm events
-  std::string channel;   // the index channel (e.g. "p1"), or the driver name for driver events
-  double index = kNoValue;     // the index [Pa] that decided
-  double score = kNoValue;     // the detector's score
+  std::string actuator;     // empty for daemon-wide events
+  std::string alarm;        // "internal_leakage" for alarm events
+  std::string channel;      // the index channel (e.g. "p1"), or the driver name for driver events
+  double index = kNoValue;  // the index [Pa] that decided
+  double score = kNoValue;  // the detector's score
   double baseline = kNoValue;  // learned healthy index [Pa]
   // Leak size when the detector estimates one: C_L [m^3/(s Pa)], the same in l/min/MPa, and the
   // flow in l/min at the current load pressure |p1 - p2|.
@@ -56,7 +64,8 @@ struct Event {
   double leak_lpm = kNoValue;
   double load_pressure = kNoValue;  // |p1 - p2| [Pa] over the deciding hop
   std::string message;              // human-readable detail (driver error text, counts...)
-  bool latched = false;             // alarm events: the alarm waits for acknowledgement
+  double unix_time = kNoValue;  // wall-clock time of publication [s since 1970], set by the worker
+  bool latched = false;         // alarm events: the alarm waits for acknowledgement
 };
 
 // Receives every event, in order, on the worker thread (never the real-time thread). publish()

@@ -1,11 +1,13 @@
 #include "daemon/event_log.hpp"
 
+#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <stdexcept>
 
@@ -16,11 +18,21 @@ void append_json_string(std::string& out, std::string_view text) {
   out += '"';
   for (char c : text) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
@@ -82,6 +94,11 @@ std::string to_json_line(const Event& event) {
   json.number("load_pressure_mpa", event.load_pressure / 1e6);
   if (is_alarm(event.kind)) json.boolean("latched", event.latched);
   json.string("message", event.message);
+  if (std::isfinite(event.unix_time)) {
+    const auto seconds = static_cast<std::time_t>(event.unix_time);
+    const auto millis = static_cast<int>((event.unix_time - static_cast<double>(seconds)) * 1e3);
+    json.string("time", fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z", fmt::gmtime(seconds), millis));
+  }
   return json.finish();
 }
 
@@ -127,11 +144,11 @@ void JsonlEventLog::publish(const Event& event) {
 void JsonlEventLog::flush() { std::fflush(file_); }
 
 void LogEventSink::publish(const Event& event) {
-  const auto level = (event.kind == EventKind::alarm_raised ||
-                      event.kind == EventKind::driver_fault || event.kind == EventKind::overrun ||
-                      event.kind == EventKind::config_rejected)
-                         ? spdlog::level::warn
-                         : spdlog::level::info;
+  const auto level =
+      (event.kind == EventKind::alarm_raised || event.kind == EventKind::driver_fault ||
+       event.kind == EventKind::overrun || event.kind == EventKind::config_rejected)
+          ? spdlog::level::warn
+          : spdlog::level::info;
   spdlog::log(level, "{}", to_log_line(event));
 }
 

@@ -26,11 +26,16 @@ sockaddr_in make_address(const std::string& address, int port) {
 
 std::string_view reason(int status) {
   switch (status) {
-    case 200: return "OK";
-    case 400: return "Bad Request";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    default: return "Error";
+    case 200:
+      return "OK";
+    case 400:
+      return "Bad Request";
+    case 404:
+      return "Not Found";
+    case 405:
+      return "Method Not Allowed";
+    default:
+      return "Error";
   }
 }
 
@@ -123,8 +128,8 @@ void HttpEndpoint::answer(int connection) {
   }
   send_all(connection, fmt::format("HTTP/1.0 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\n"
                                    "Connection: close\r\n\r\n",
-                                   response.status, reason(response.status),
-                                   response.content_type, response.body.size()));
+                                   response.status, reason(response.status), response.content_type,
+                                   response.body.size()));
   send_all(connection, response.body);
 }
 
@@ -136,8 +141,8 @@ HttpResponse http_request(const std::string& address, int port, const std::strin
   if (::connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0) {
     const std::string error = std::strerror(errno);
     ::close(fd);
-    throw std::runtime_error(fmt::format("no leakmon daemon answers on {}:{} ({})", address, port,
-                                         error));
+    throw std::runtime_error(
+        fmt::format("no leakmon daemon answers on {}:{} ({})", address, port, error));
   }
   send_all(fd, fmt::format("{} {} HTTP/1.0\r\nHost: {}\r\nContent-Length: 0\r\n\r\n", method,
                            target, address));

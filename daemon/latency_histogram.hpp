@@ -45,7 +45,8 @@ class LatencyHistogram {
 
   // Number of recordings below `ns` (bin resolution: 1 us).
   std::uint64_t count_below(std::int64_t ns) const noexcept {
-    const auto limit = std::min<std::size_t>(static_cast<std::size_t>(std::max<std::int64_t>(ns, 0) / 1000), kBins);
+    const auto limit = std::min<std::size_t>(
+        static_cast<std::size_t>(std::max<std::int64_t>(ns, 0) / 1000), kBins);
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < limit; ++i) total += bins_[i].load(std::memory_order_relaxed);
     return total;
@@ -59,7 +60,8 @@ class LatencyHistogram {
     std::uint64_t seen = 0;
     for (std::size_t i = 0; i < kBins; ++i) {
       seen += bins_[i].load(std::memory_order_relaxed);
-      if (seen >= rank) return std::min<std::int64_t>(static_cast<std::int64_t>(i + 1) * 1000, max_ns());
+      if (seen >= rank)
+        return std::min<std::int64_t>(static_cast<std::int64_t>(i + 1) * 1000, max_ns());
     }
     return max_ns();
   }

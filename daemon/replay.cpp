@@ -54,17 +54,18 @@ DaemonConfig bind_to_capture(const io::Capture& capture, const DaemonConfig& con
 
 DaemonConfig default_replay_config(const io::Capture& capture) {
   if (!capture.has("p1")) {
-    throw io::CaptureError(fmt::format("{}: the capture has no p1 column, which the default "
-                                       "replay configuration indexes",
-                                       capture.path));
+    throw io::CaptureError(
+        fmt::format("{}: the capture has no p1 column, which the default "
+                    "replay configuration indexes",
+                    capture.path));
   }
   DaemonConfig config;
   config.source = "built-in replay defaults";
   ActuatorConfig actuator;
   actuator.name = "actuator";
-  for (auto [role, ref] : {std::pair{"p1", &actuator.p1}, std::pair{"p2", &actuator.p2},
-                           std::pair{"u", &actuator.u}, std::pair{"x", &actuator.x},
-                           std::pair{"xref", &actuator.xref}}) {
+  for (auto [role, ref] :
+       {std::pair{"p1", &actuator.p1}, std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
+        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
     if (capture.has(role)) *ref = ChannelRef{kCaptureDriver, role, std::nullopt};
   }
   config.actuators.push_back(actuator);
@@ -79,8 +80,8 @@ ReplayResult replay_capture(const io::Capture& capture, const DaemonConfig& conf
                         config, options);
 }
 
-ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture,
-                            const DaemonConfig& config, const ReplayOptions& options) {
+ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture, const DaemonConfig& config,
+                            const ReplayOptions& options) {
   const DaemonConfig bound = bind_to_capture(*capture, config);
   const GroupConfig& group = bound.groups.front();
 
@@ -94,7 +95,8 @@ ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture,
   AcquisitionLoop loop(group.period_ns, {&driver}, ring);
 
   std::vector<ChannelRef> channels;
-  for (const auto& name : driver.channels()) channels.push_back({kCaptureDriver, name, std::nullopt});
+  for (const auto& name : driver.channels())
+    channels.push_back({kCaptureDriver, name, std::nullopt});
   CollectingEventSink events;
   Worker worker(bound, {GroupInput{group.name, &ring, channels, group.period_ns}}, {&events});
 

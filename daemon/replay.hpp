@@ -23,10 +23,10 @@ struct ReplayOptions {
 };
 
 struct ReplayResult {
-  std::vector<Event> events;  // in order
-  std::uint64_t samples_read = 0;       // rows the loop read from the capture
-  std::uint64_t samples_processed = 0;  // samples the worker consumed
-  std::uint64_t ring_drops = 0;         // 0 unless realtime and the worker fell behind
+  std::vector<Event> events;              // in order
+  std::uint64_t samples_read = 0;         // rows the loop read from the capture
+  std::uint64_t samples_processed = 0;    // samples the worker consumed
+  std::uint64_t ring_drops = 0;           // 0 unless realtime and the worker fell behind
   std::vector<ActuatorStatus> actuators;  // state at the end
 };
 
@@ -41,7 +41,7 @@ DaemonConfig default_replay_config(const io::Capture& capture);
 // Throws config::ConfigError / io::CaptureError on channels the capture does not have.
 ReplayResult replay_capture(const io::Capture& capture, const DaemonConfig& config,
                             const ReplayOptions& options = {});
-ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture,
-                            const DaemonConfig& config, const ReplayOptions& options = {});
+ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture, const DaemonConfig& config,
+                            const ReplayOptions& options = {});
 
 }  // namespace leakmon::daemon

@@ -12,9 +12,9 @@ namespace leakmon::daemon {
 inline constexpr std::size_t kMaxGroupChannels = 32;
 
 struct Sample {
-  std::uint64_t tick = 0;          // tick index since the group started (gaps = missed cycles)
-  std::int64_t monotonic_ns = 0;   // when the loop read the drivers (simulated under replay)
-  double t = 0.0;                  // source time [s]: the capture's t under replay, else ticks * period
+  std::uint64_t tick = 0;         // tick index since the group started (gaps = missed cycles)
+  std::int64_t monotonic_ns = 0;  // when the loop read the drivers (simulated under replay)
+  double t = 0.0;  // source time [s]: the capture's t under replay, else ticks * period
   std::uint32_t channel_count = 0;
   std::array<double, kMaxGroupChannels> values{};  // NaN marks a gap
 };

@@ -17,9 +17,7 @@ void ServiceNotifier::send(const std::string& message) {
   if (active_) sd_notify(0, message.c_str());
 }
 
-void ServiceNotifier::ready(const std::string& status) {
-  send("READY=1\nSTATUS=" + status);
-}
+void ServiceNotifier::ready(const std::string& status) { send("READY=1\nSTATUS=" + status); }
 
 void ServiceNotifier::status(const std::string& status) { send("STATUS=" + status); }
 

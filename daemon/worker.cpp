@@ -1,6 +1,8 @@
 #include "daemon/worker.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 #include "daemon/acquisition_loop.hpp"
 
@@ -33,7 +35,8 @@ Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
           group.input.channels.begin(), group.input.channels.end(),
           [&](const ChannelRef& c) { return c.driver == group.input.channels.front().driver; });
       std::vector<std::string> columns;
-      for (const auto& c : group.input.channels) columns.push_back(one_driver ? c.channel : c.text());
+      for (const auto& c : group.input.channels)
+        columns.push_back(one_driver ? c.channel : c.text());
       group.recorder = std::make_unique<CaptureRecorder>(
           group.input.name, columns, 1e9 / static_cast<double>(group.input.period_ns),
           config.recording);
@@ -60,9 +63,9 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
         }
       }
     }
-    monitors.push_back(kept ? std::move(kept)
-                            : std::make_unique<ActuatorMonitor>(actuator, layout,
-                                                                group.input.period_ns));
+    monitors.push_back(
+        kept ? std::move(kept)
+             : std::make_unique<ActuatorMonitor>(actuator, layout, group.input.period_ns));
   }
   group.monitors = std::move(monitors);
 }
@@ -90,9 +93,8 @@ void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_n
     const std::uint64_t missing = sample.tick - group.next_tick;
     const double period_s = static_cast<double>(group.input.period_ns) / 1e9;
     for (auto& monitor : group.monitors) {
-      const std::uint64_t feed =
-          std::min<std::uint64_t>(missing, monitor->config().features.window +
-                                               monitor->config().features.step);
+      const std::uint64_t feed = std::min<std::uint64_t>(
+          missing, monitor->config().features.window + monitor->config().features.step);
       for (std::uint64_t k = feed; k > 0; --k) {
         monitor->push_gap(sample.t - static_cast<double>(k) * period_s, publish);
       }
@@ -112,7 +114,12 @@ void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_n
 
 void Worker::publish_locked(const Event& event) {
   ++events_;
-  for (auto* sink : sinks_) sink->publish(event);
+  Event stamped = event;
+  if (std::isnan(stamped.unix_time)) {
+    stamped.unix_time =
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  }
+  for (auto* sink : sinks_) sink->publish(stamped);
 }
 
 void Worker::publish(const Event& event) {

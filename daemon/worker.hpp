@@ -31,8 +31,7 @@ class Worker {
  public:
   // Builds a monitor per actuator (throws config::ConfigError / std::invalid_argument on a
   // detector that cannot be built) and a recorder per group when recording is configured.
-  Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
-         std::vector<EventSink*> sinks);
+  Worker(const DaemonConfig& config, std::vector<GroupInput> groups, std::vector<EventSink*> sinks);
   ~Worker();
 
   // Pops and processes everything queued now; returns the samples processed. `now_ns` is the

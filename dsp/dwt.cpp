@@ -41,15 +41,16 @@ void decimate(std::span<const double> signal, std::span<const double> filter, Mo
   auto at = [&](std::size_t i) { return signal[i]; };
   // scratch holds the extended signal: a_ext[i] at scratch[left_ext + i].
   double* ext = scratch.data() + d.left_ext;
-  for (std::size_t m = 1; m <= d.left_ext; ++m) ext[-static_cast<std::ptrdiff_t>(m)] =
-      extend_before_start(mode, n, m, at);
+  for (std::size_t m = 1; m <= d.left_ext; ++m)
+    ext[-static_cast<std::ptrdiff_t>(m)] = extend_before_start(mode, n, m, at);
   std::copy(signal.begin(), signal.end(), ext);
   for (std::size_t m = 1; m <= d.right_ext; ++m) ext[n - 1 + m] = extend_after_end(mode, n, m, at);
   const std::size_t taps = filter.size();
   for (std::size_t k = 0; k < d.n_out; ++k) {
     const double* newest = scratch.data() + d.left_ext + 2 * k + d.phase;
     double sum = 0.0;
-    for (std::size_t f = 0; f < taps; ++f) sum += filter[f] * newest[-static_cast<std::ptrdiff_t>(f)];
+    for (std::size_t f = 0; f < taps; ++f)
+      sum += filter[f] * newest[-static_cast<std::ptrdiff_t>(f)];
     out[k] = sum;
   }
 }

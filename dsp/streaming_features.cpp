@@ -52,34 +52,91 @@ DetailFeature feature_from_energy(double energy, std::size_t count) {
   return {std::sqrt(energy / static_cast<double>(count)), energy, true};
 }
 
-// out[k*C + c] = sum_f filter[f] * newest[(2k - f) * C + c] for k < count: `count` decimated
-// outputs of C interleaved channels. The sum runs over f in order, as dsp::decimate does, so
-// both give the same bits; independent outputs and channels form the inner loops so that they
-// vectorise and no output waits on another's additions.
-void decimate_rows(const double* newest, std::size_t count, std::size_t channels,
-                   std::span<const double> filter, double* out) {
-  const std::size_t values = count * channels;
-  std::fill(out, out + values, 0.0);
-  const std::size_t stride = 2 * channels;
-  for (std::size_t f = 0; f < filter.size(); ++f) {
-    const double tap = filter[f];
-    const double* src = newest - static_cast<std::ptrdiff_t>(f * channels);
-    if (channels == 1) {
-      for (std::size_t k = 0; k < count; ++k) out[k] += tap * src[2 * k];
-    } else {
-      for (std::size_t k = 0; k < count; ++k) {
-        const double* in_row = src + k * stride;
-        double* out_row = out + k * channels;
-        for (std::size_t c = 0; c < channels; ++c) out_row[c] += tap * in_row[c];
-      }
+// Channels [first, first + B) of decimate_rows, B at a time, with the B running sums in
+// registers.
+template <std::size_t B>
+void decimate_channel_block(const double* newest, std::size_t count, std::size_t channels,
+                            std::span<const double> filter, double* __restrict__ out,
+                            std::size_t first) {
+  for (std::size_t k = 0; k < count; ++k) {
+    double sum[B] = {};
+    const double* in = newest + 2 * k * channels + first;
+    for (std::size_t f = 0; f < filter.size(); ++f) {
+      const double tap = filter[f];
+      const double* __restrict__ row = in - static_cast<std::ptrdiff_t>(f * channels);
+#pragma GCC unroll 8
+      for (std::size_t b = 0; b < B; ++b) sum[b] += tap * row[b];
     }
+    for (std::size_t b = 0; b < B; ++b) out[k * channels + first + b] = sum[b];
   }
 }
 
+// One channel: outputs [0, B) of decimate_rows, B at a time, with the B running sums in
+// registers.
+template <std::size_t B>
+void decimate_output_block(const double* newest, std::span<const double> filter,
+                           double* __restrict__ out) {
+  double sum[B] = {};
+  for (std::size_t f = 0; f < filter.size(); ++f) {
+    const double tap = filter[f];
+    const double* __restrict__ src = newest - static_cast<std::ptrdiff_t>(f);
+#pragma GCC unroll 8
+    for (std::size_t b = 0; b < B; ++b) sum[b] += tap * src[2 * b];
+  }
+  for (std::size_t b = 0; b < B; ++b) out[b] = sum[b];
+}
+
+// out[k*C + c] = sum_f filter[f] * newest[(2k - f) * C + c] for k < count: `count` decimated
+// outputs of C interleaved channels. Each sum runs over f in order from 0.0, as dsp::decimate
+// does, so both give the same bits; what runs in parallel is independent sums (channels, or
+// outputs of a single channel), so the loops vectorise and no addition waits on another.
+void decimate_rows(const double* newest, std::size_t count, std::size_t channels,
+                   std::span<const double> filter, double* __restrict__ out) {
+  if (channels == 1) {
+    constexpr std::size_t kOutputs = 8;
+    std::size_t k = 0;
+    for (; k + kOutputs <= count; k += kOutputs) {
+      decimate_output_block<kOutputs>(newest + 2 * k, filter, out + k);
+    }
+    for (; k < count; ++k) decimate_output_block<1>(newest + 2 * k, filter, out + k);
+    return;
+  }
+  constexpr std::size_t kBlock = 8;
+  std::size_t c = 0;
+  for (; c + kBlock <= channels; c += kBlock) {
+    decimate_channel_block<kBlock>(newest, count, channels, filter, out, c);
+  }
+  for (; c < channels; ++c) decimate_channel_block<1>(newest, count, channels, filter, out, c);
+}
+
 void add_squares(const double* rows, std::size_t count, std::size_t channels, double* energy) {
-  for (std::size_t k = 0; k < count; ++k) {
-    const double* row = rows + k * channels;
-    for (std::size_t c = 0; c < channels; ++c) energy[c] += row[c] * row[c];
+  if (channels == 1) {
+    // Four partial sums: one running sum would wait on each addition's latency.
+    double lane[4] = {0.0, 0.0, 0.0, 0.0};
+    std::size_t k = 0;
+    for (; k + 4 <= count; k += 4) {
+      for (std::size_t i = 0; i < 4; ++i) lane[i] += rows[k + i] * rows[k + i];
+    }
+    for (; k < count; ++k) lane[k % 4] += rows[k] * rows[k];
+    energy[0] += (lane[0] + lane[1]) + (lane[2] + lane[3]);
+    return;
+  }
+  // Eight channels at a time, their sums in registers; each channel still sums in row order.
+  constexpr std::size_t kBlock = 8;
+  std::size_t c = 0;
+  for (; c + kBlock <= channels; c += kBlock) {
+    double sum[kBlock];
+    for (std::size_t b = 0; b < kBlock; ++b) sum[b] = energy[c + b];
+    for (std::size_t k = 0; k < count; ++k) {
+      const double* __restrict__ row = rows + k * channels + c;
+#pragma GCC unroll 8
+      for (std::size_t b = 0; b < kBlock; ++b) sum[b] += row[b] * row[b];
+    }
+    for (std::size_t b = 0; b < kBlock; ++b) energy[c + b] = sum[b];
+  }
+  for (; c < channels; ++c) {
+    for (std::size_t k = 0; k < count; ++k)
+      energy[c] += rows[k * channels + c] * rows[k * channels + c];
   }
 }
 
@@ -96,6 +153,37 @@ struct LevelPlan {
   std::size_t clean_hi = 0;
   std::size_t edge_left = 0;   // input values a[0, edge_left) held for the left boundary
   std::size_t edge_right = 0;  // input values a[n_in - edge_right, n_in) for the right one
+};
+
+// One extension value of one edge buffer, resolved at construction so that the per-window work
+// is a copy or a short formula over the channels: the same values, by the same arithmetic, as
+// extend_before_start/extend_after_end (the streaming-equals-batch tests check every mode).
+struct ExtensionSlot {
+  enum class Kind { zero, copy, negate, smooth, antireflect } kind = Kind::zero;
+  double* dst = nullptr;
+  const double* a = nullptr;  // copy/negate: source; smooth/antireflect: the edge value
+  const double* b = nullptr;  // smooth: the value next to the edge; antireflect: the mirrored one
+  double factor = 0.0;        // smooth: distance from the edge
+
+  void fill(std::size_t channels) const noexcept {
+    switch (kind) {
+      case Kind::zero:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = 0.0;
+        break;
+      case Kind::copy:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c];
+        break;
+      case Kind::negate:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = -a[c];
+        break;
+      case Kind::smooth:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] + factor * (a[c] - b[c]);
+        break;
+      case Kind::antireflect:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] - (b[c] - a[c]);
+        break;
+    }
+  }
 };
 
 std::optional<std::vector<LevelPlan>> plan_incremental(const FeatureParams& params,
@@ -120,8 +208,8 @@ std::optional<std::vector<LevelPlan>> plan_incremental(const FeatureParams& para
     p.clean_hi = std::min(p.dec.n_out, static_cast<std::size_t>(highest / 2 + 1));
     if (p.clean_lo >= p.clean_hi) return std::nullopt;
     const std::size_t left_reads = p.clean_lo == 0 ? 0 : 2 * (p.clean_lo - 1) + p.dec.phase + 1;
-    const long long first_right_read = static_cast<long long>(2 * p.clean_hi + p.dec.phase) -
-                                       static_cast<long long>(taps - 1);
+    const long long first_right_read =
+        static_cast<long long>(2 * p.clean_hi + p.dec.phase) - static_cast<long long>(taps - 1);
     const std::size_t right_reads =
         first_right_read >= static_cast<long long>(n_in)
             ? 0
@@ -161,6 +249,7 @@ struct StreamingFeatures::Engine {
         left_out.emplace_back(l.clean_lo * channels);
         right_out.emplace_back((l.dec.n_out - l.clean_hi) * channels);
       }
+      for (std::size_t j = 0; j < levels.size(); ++j) build_extension_recipe(j);
     } else {
       transform.emplace(params.window, w, params.mode, params.level);
       window_buf.resize(params.window);
@@ -185,7 +274,8 @@ struct StreamingFeatures::Engine {
     }
     if (t < next_start) return false;  // step > window: this sample is in no window
     if (samples.end() != t) samples.restart(t);
-    std::memcpy(samples.append(), sample.data(), channels * sizeof(double));
+    double* row = samples.append();
+    for (std::size_t c = 0; c < channels; ++c) row[c] = sample[c];
     if (seen != next_start + params.window) return false;
     const std::uint64_t start = next_start;
     if (levels.empty()) {
@@ -194,8 +284,8 @@ struct StreamingFeatures::Engine {
       update_window(start);
     }
     for (std::size_t c = 0; c < channels; ++c) {
-      latest[c] = gap_end[c] > start ? DetailFeature{}
-                                     : feature_from_energy(energy[c], detail_count());
+      latest[c] =
+          gap_end[c] > start ? DetailFeature{} : feature_from_energy(energy[c], detail_count());
     }
     next_start += params.step;
     samples.release_before(next_start);
@@ -252,10 +342,12 @@ struct StreamingFeatures::Engine {
                     (l.edge_left - below.clean_lo) * row_bytes);
         std::memcpy(right_real, input.row(in_origin + right_first),
                     (below.clean_hi - right_first) * row_bytes);
-        std::memcpy(right_real + (below.clean_hi - right_first) * channels,
-                    right_out[j - 1].data(), (n_in - below.clean_hi) * row_bytes);
+        std::memcpy(right_real + (below.clean_hi - right_first) * channels, right_out[j - 1].data(),
+                    (n_in - below.clean_hi) * row_bytes);
       }
-      extend_edges(l, left_real, right_real);
+      for (std::size_t e = j == 0 ? 0 : extension_end[j - 1]; e < extension_end[j]; ++e) {
+        extension[e].fill(channels);
+      }
 
       const std::size_t right_count = l.dec.n_out - l.clean_hi;
       decimate_rows(left_buf[j].data() + (l.dec.left_ext + l.dec.phase) * channels, l.clean_lo,
@@ -274,25 +366,52 @@ struct StreamingFeatures::Engine {
     add_squares(right_out.back().data(), top.dec.n_out - top.clean_hi, channels, energy.data());
   }
 
-  // Fills the extension rows before left_real and after right_real, channel by channel.
-  void extend_edges(const LevelPlan& l, double* left_real, double* right_real) const noexcept {
+  // Resolves every extension value of level j's edge buffers to an ExtensionSlot. The plan
+  // guarantees a single reflection, so every value reads the edges' real rows.
+  void build_extension_recipe(std::size_t j) {
+    const LevelPlan& l = levels[j];
     const std::size_t n = l.dec.n_in;
     const std::size_t right_first = n - l.edge_right;
-    for (std::size_t c = 0; c < channels; ++c) {
-      auto at = [&](std::size_t i) {
-        assert(i < l.edge_left || i >= right_first);
-        return i < l.edge_left ? left_real[i * channels + c]
-                               : right_real[(i - right_first) * channels + c];
-      };
-      for (std::size_t m = 1; m <= l.dec.left_ext; ++m) {
-        left_real[-static_cast<std::ptrdiff_t>(m * channels) + static_cast<std::ptrdiff_t>(c)] =
-            extend_before_start(params.mode, n, m, at);
+    double* left_real = left_buf[j].data() + l.dec.left_ext * channels;
+    double* right_real = right_buf[j].data();
+    auto row = [&](std::size_t i) -> const double* {
+      if (i < l.edge_left) return left_real + i * channels;
+      if (i < right_first) throw std::logic_error("extension reads outside the edge buffers");
+      return right_real + (i - right_first) * channels;
+    };
+    // For the modes that only pick (and maybe negate) a sample, probe which one: a[i] = i + 1.
+    auto probe = [](std::size_t i) { return static_cast<double>(i) + 1.0; };
+    auto slot = [&](double* dst, std::size_t m, bool left) {
+      ExtensionSlot e;
+      e.dst = dst;
+      const std::size_t edge = left ? 0 : n - 1;
+      const std::size_t inward = left ? edge + 1 : edge - 1;
+      switch (params.mode) {
+        case Mode::zero:
+          break;
+        case Mode::smooth:
+          e = {ExtensionSlot::Kind::smooth, dst, row(edge), row(inward), static_cast<double>(m)};
+          break;
+        case Mode::antireflect:
+          e = {ExtensionSlot::Kind::antireflect, dst, row(edge), row(left ? edge + m : edge - m),
+               0.0};
+          break;
+        default: {
+          const double v = left ? extend_before_start(params.mode, n, m, probe)
+                                : extend_after_end(params.mode, n, m, probe);
+          e.kind = v < 0 ? ExtensionSlot::Kind::negate : ExtensionSlot::Kind::copy;
+          e.a = row(static_cast<std::size_t>(std::abs(v)) - 1);
+        }
       }
-      for (std::size_t m = 1; m <= l.dec.right_ext; ++m) {
-        right_real[(l.edge_right - 1 + m) * channels + c] =
-            extend_after_end(params.mode, n, m, at);
-      }
+      extension.push_back(e);
+    };
+    for (std::size_t m = 1; m <= l.dec.left_ext; ++m) {
+      slot(left_real - m * channels, m, true);
     }
+    for (std::size_t m = 1; m <= l.dec.right_ext; ++m) {
+      slot(right_real + (l.edge_right - 1 + m) * channels, m, false);
+    }
+    extension_end.push_back(extension.size());
   }
 
   FeatureParams params;
@@ -302,6 +421,8 @@ struct StreamingFeatures::Engine {
   RowHistory samples;
   std::vector<RowHistory> coeffs;  // per level: its clean coefficients
   std::vector<std::vector<double>> left_buf, right_buf, left_out, right_out;
+  std::vector<ExtensionSlot> extension;    // all levels' extension values, level by level
+  std::vector<std::size_t> extension_end;  // per level: one past its last slot
   std::optional<DetailTransform> transform;
   std::vector<double> window_buf;
   std::vector<double> energy;

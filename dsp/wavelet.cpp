@@ -34,8 +34,7 @@ const Wavelet* find(std::string_view name) {
 const Wavelet& wavelet(std::string_view name) {
   if (const Wavelet* w = find(name)) return *w;
   throw std::invalid_argument(fmt::format(
-      "wavelet: unknown wavelet '{}' (offered: haar, db1..db20, sym2..sym20, coif1..coif5)",
-      name));
+      "wavelet: unknown wavelet '{}' (offered: haar, db1..db20, sym2..sym20, coif1..coif5)", name));
 }
 
 bool has_wavelet(std::string_view name) { return find(name) != nullptr; }

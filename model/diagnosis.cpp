@@ -34,13 +34,14 @@ double total(const std::vector<double>& v) {
   return sum;
 }
 
-// Paired t statistic of the per-segment error reduction: each held-out segment is one
-// comparison of the two models on the same data.
+// Paired t statistic of the per-segment log error ratio: each held-out segment is one
+// comparison of the two models on the same data. The log keeps a few segments with a huge
+// improvement (say, the only large steps) from hiding whether the gain is consistent.
 double paired_t(const std::vector<double>& before, const std::vector<double>& after) {
   const auto n = static_cast<double>(before.size());
   double sum = 0.0, sum2 = 0.0;
   for (std::size_t i = 0; i < before.size(); ++i) {
-    const double d = before[i] - after[i];
+    const double d = std::log(std::max(before[i], 1e-300) / std::max(after[i], 1e-300));
     sum += d;
     sum2 += d * d;
   }
@@ -116,8 +117,10 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   std::map<std::string, EffectCandidate> best_candidate;
   for (const auto& candidate : library) {
     screening.free_calibration = {true, true, true, true};
+    // From the catalogue calibration, not the nominal fit: a large effect distorts the
+    // nominal fit, which then leads the solver into a compensating local minimum.
     RankedEffect r = score(candidate, fit_model(predictor, screening_segments, &candidate,
-                                                nominal.parameters.calibration, screening));
+                                                Calibration{}, screening));
     auto it = best.find(candidate.effect);
     if (it == best.end() || r.score > it->second.score) {
       best[candidate.effect] = std::move(r);
@@ -140,7 +143,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
       fp.initial = std::clamp(best[name].fit.values[i], fp.lower, fp.upper);
     }
     RankedEffect refined = score(candidate, fit_model(predictor, d.fitting_used, &candidate,
-                                                      nominal.parameters.calibration,
+                                                      best[name].fit.parameters.calibration,
                                                       settings.fit));
     refined.refined = true;
     best[name] = std::move(refined);

@@ -72,7 +72,11 @@ void BM_NaiveRecompute(benchmark::State& state) {
   benchmark::DoNotOptimize(sink);
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kInstants * channels));
 }
-BENCHMARK(BM_NaiveRecompute)->ArgNames({"channels"})->Arg(1)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NaiveRecompute)
+    ->ArgNames({"channels"})
+    ->Arg(1)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

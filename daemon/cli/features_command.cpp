@@ -19,7 +19,8 @@ namespace {
 
 std::size_t positive_size(const ArgParser& args, std::string_view name) {
   const long long value = args.get_int(name);
-  if (value < 1) throw UsageError(fmt::format("option '--{}': must be at least 1, got {}", name, value));
+  if (value < 1)
+    throw UsageError(fmt::format("option '--{}': must be at least 1, got {}", name, value));
   return static_cast<std::size_t>(value);
 }
 
@@ -69,7 +70,8 @@ int run_features(int argc, char** argv) {
   if (!column) {
     std::string present;
     for (const auto& name : reader.columns()) present += (present.empty() ? "" : ", ") + name;
-    throw io::CaptureError(fmt::format("{}: no column '{}' (columns: {})", in_path, channel, present));
+    throw io::CaptureError(
+        fmt::format("{}: no column '{}' (columns: {})", in_path, channel, present));
   }
 
   const std::string out_path = args.get("out");

@@ -25,6 +25,7 @@ constexpr Subcommand kSubcommands[] = {
     {"features", "sliding-window wavelet index of one capture channel", leakmon::cli::run_features},
     {"sim", "simulate the test rig (presets paper-fig10/13/16, scenario YAML)", leakmon::cli::run_sim},
     {"evaluate", "Monte-Carlo error rates of the leak detectors", leakmon::cli::run_evaluate},
+    {"realdata", "the index on the vtnsi real-actuator data (leak and gear-damage pairs)", leakmon::cli::run_realdata},
     {"model", "model check: where the simulation disagrees with data, and why", leakmon::cli::run_model},
 };
 

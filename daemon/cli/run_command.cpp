@@ -20,8 +20,8 @@ void configure_daemon_logging() {
 
 int run_run(int argc, char** argv) {
   ArgParser args("run", "run the leak monitoring daemon");
-  args.option("config", "CONFIG.yaml", "configuration file (schema: config/README.md)", std::nullopt,
-              true);
+  args.option("config", "CONFIG.yaml", "configuration file (schema: config/README.md)",
+              std::nullopt, true);
   if (!args.parse(argc, argv)) return 0;
   configure_daemon_logging();
   daemon::Daemon service(args.get("config"));

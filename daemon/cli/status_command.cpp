@@ -21,8 +21,8 @@ std::pair<std::string, int> endpoint(const ArgParser& args) {
   if (args.get("port").empty()) {
     metrics = daemon::load_config(args.get("config")).metrics;
     if (metrics.port == 0) {
-      throw UsageError(fmt::format("{} disables the metrics endpoint (metrics.port: 0)",
-                                   args.get("config")));
+      throw UsageError(
+          fmt::format("{} disables the metrics endpoint (metrics.port: 0)", args.get("config")));
     }
   } else {
     metrics.port = static_cast<int>(args.get_int("port"));

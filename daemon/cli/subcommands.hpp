@@ -8,6 +8,7 @@ int run_features(int argc, char** argv);
 int run_model(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_evaluate(int argc, char** argv);
+int run_realdata(int argc, char** argv);
 int run_run(int argc, char** argv);
 int run_replay(int argc, char** argv);
 int run_check_config(int argc, char** argv);

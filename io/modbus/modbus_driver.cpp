@@ -13,7 +13,8 @@ namespace {
 
 class ModbusDriver final : public Driver {
  public:
-  explicit ModbusDriver(modbus::ModbusConfig config) : poller_(std::move(config)) {
+  explicit ModbusDriver(modbus::ModbusConfig config)
+      : poller_(std::move(config)), snapshot_(poller_.config().channels.size()) {
     for (const auto& channel : poller_.config().channels) channel_names_.push_back(channel.name);
   }
   ~ModbusDriver() override { ModbusDriver::stop(); }
@@ -29,10 +30,12 @@ class ModbusDriver final : public Driver {
   ReadStatus read(const Tick& tick, std::span<double> values) override {
     const auto& specs = poller_.config().channels;
     const std::size_t n = std::min(values.size(), specs.size());
+    const bool have_snapshot = poller_.latest(snapshot_);
     for (std::size_t i = 0; i < n; ++i) {
-      const auto sample = poller_.latest(i);
-      if (sample && tick.monotonic_ns - sample->received_ns <= specs[i].max_age_ns) {
-        values[i] = sample->value;
+      const modbus::StampedValue& sample = snapshot_[i];
+      if (have_snapshot && sample.received_ns != 0 &&
+          tick.monotonic_ns - sample.received_ns <= specs[i].max_age_ns) {
+        values[i] = sample.value;
       } else {
         values[i] = std::numeric_limits<double>::quiet_NaN();
         stale_values_.fetch_add(1, std::memory_order_relaxed);
@@ -49,6 +52,7 @@ class ModbusDriver final : public Driver {
 
  private:
   modbus::ModbusPoller poller_;
+  std::vector<modbus::StampedValue> snapshot_;  // read()'s scratch, sized once: no allocation
   std::vector<std::string> channel_names_;
   std::atomic<std::uint64_t> stale_values_{0};
 };

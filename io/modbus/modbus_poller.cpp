@@ -24,7 +24,7 @@ std::string_view to_string_state(int state) {
 ModbusPoller::ModbusPoller(ModbusConfig config)
     : config_(std::move(config)),
       requests_(plan_requests(config_.channels, config_.max_registers_per_request)),
-      values_(std::make_unique<LatestValue[]>(config_.channels.size())),
+      values_(config_.channels.size()),
       words_(static_cast<std::size_t>(config_.max_registers_per_request)),
       bits_(static_cast<std::size_t>(kMaxBitsPerRequest)),
       link_(std::make_unique<ModbusLink>(config_)) {}
@@ -141,6 +141,7 @@ bool ModbusPoller::poll_once() {
 }
 
 void ModbusPoller::publish(const ReadRequest& request, std::int64_t received_ns) {
+  values_.begin_write();
   for (const ChannelSlot& slot : request.slots) {
     const ChannelSpec& channel = config_.channels[slot.channel];
     const auto offset = static_cast<std::size_t>(slot.offset);
@@ -151,8 +152,9 @@ void ModbusPoller::publish(const ReadRequest& request, std::int64_t received_ns)
       raw = decode_registers(std::span<const std::uint16_t>(words_).subspan(offset),
                              channel.data_type, channel.byte_order);
     }
-    values_[slot.channel].publish(raw * channel.scale + channel.offset, received_ns);
+    values_.set(slot.channel, raw * channel.scale + channel.offset, received_ns);
   }
+  values_.end_write();
 }
 
 void ModbusPoller::record_error(Outcome outcome, const std::string& what) {

@@ -34,8 +34,9 @@ class ModbusPoller {
   void start();
   void stop();  // joins; at most one response timeout plus a poll period
 
-  // Real-time safe: the newest value of channel `index` and when it arrived.
-  std::optional<StampedValue> latest(std::size_t index) const { return values_[index].read(); }
+  // Real-time safe: the newest value of every channel and when it arrived (one consistent
+  // snapshot); false when the snapshot raced the poller too often.
+  bool latest(std::span<StampedValue> out) const { return values_.read(out); }
 
   DriverHealth health() const;
 
@@ -51,7 +52,7 @@ class ModbusPoller {
 
   ModbusConfig config_;
   std::vector<ReadRequest> requests_;
-  std::unique_ptr<LatestValue[]> values_;
+  LatestValues values_;
   std::vector<std::uint16_t> words_;  // scratch for one request
   std::vector<std::uint8_t> bits_;
   std::unique_ptr<ModbusLink> link_;

@@ -52,17 +52,15 @@ void ReplayDriver::start() {
     bind_columns();
   }
   if (settings_.loop && capture_->rows() < 2) {
-    throw DriverError(fmt::format("replay driver '{}': a looping capture needs at least 2 rows",
-                                  settings_.name));
+    throw DriverError(
+        fmt::format("replay driver '{}': a looping capture needs at least 2 rows", settings_.name));
   }
   next_row_ = 0;
   loop_offset_ = 0.0;
   source_time_.reset();
 }
 
-double ReplayDriver::sample_rate_hz() const {
-  return capture_ ? capture_->sample_rate_hz() : 0.0;
-}
+double ReplayDriver::sample_rate_hz() const { return capture_ ? capture_->sample_rate_hz() : 0.0; }
 
 ReadStatus ReplayDriver::read(const Tick& /*tick*/, std::span<double> values) {
   const std::size_t rows = t_ ? t_->size() : 0;

@@ -14,12 +14,18 @@ constexpr double kM3sPaPerLpmMpa = 1.0 / 60000.0 / 1e6;
 
 double field(const sim::RigSample& s, std::size_t index) {
   switch (index) {
-    case 0: return s.xref;
-    case 1: return s.u;
-    case 2: return s.x;
-    case 3: return s.p1;
-    case 4: return s.p2;
-    default: return s.q_int;
+    case 0:
+      return s.xref;
+    case 1:
+      return s.u;
+    case 2:
+      return s.x;
+    case 3:
+      return s.p1;
+    case 4:
+      return s.p2;
+    default:
+      return s.q_int;
   }
 }
 
@@ -32,8 +38,8 @@ SimDriver::SimDriver(SimSettings settings) : settings_(std::move(settings)) {
     const auto it = std::find_if(kSimChannels.begin(), kSimChannels.end(),
                                  [&](const char* c) { return name == c; });
     if (it == kSimChannels.end()) {
-      throw DriverError(fmt::format("sim driver '{}': no channel '{}' (it has: {})",
-                                    settings_.name, name, fmt::join(kSimChannels, ", ")));
+      throw DriverError(fmt::format("sim driver '{}': no channel '{}' (it has: {})", settings_.name,
+                                    name, fmt::join(kSimChannels, ", ")));
     }
     channels_.push_back(name);
     fields_.push_back(static_cast<std::size_t>(it - kSimChannels.begin()));
@@ -42,8 +48,8 @@ SimDriver::SimDriver(SimSettings settings) : settings_(std::move(settings)) {
 
 void SimDriver::start() {
   rig_ = std::make_unique<sim::Rig>(settings_.scenario);
-  if (settings_.leak) rig_->set_internal_leak(settings_.leak->C_L, settings_.leak->onset_s,
-                                              settings_.leak->ramp_s);
+  if (settings_.leak)
+    rig_->set_internal_leak(settings_.leak->C_L, settings_.leak->onset_s, settings_.leak->ramp_s);
   source_time_.reset();
 }
 

@@ -39,10 +39,13 @@ std::string config_text(const std::string& dir, int port, const std::string& ala
          "  - name: cyl\n"
          "    channels: {p1: p1, p2: p2, u: u, x: x, xref: xref}\n"
          "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 6}}\n"
-         "    alarm: " + alarm + "\n"
+         "    alarm: " +
+         alarm +
+         "\n"
          "events: {log: events.jsonl}\n"
          "recording: {directory: rec, rotate_seconds: 10}\n"
-         "metrics: {port: " + std::to_string(port) + "}\n" + (dir.empty() ? "" : "");
+         "metrics: {port: " +
+         std::to_string(port) + "}\n" + (dir.empty() ? "" : "");
 }
 
 void write(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
@@ -87,18 +90,20 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   write(cfg, config_text(dir, port, "{latching: true, off_delay_s: 2}"));
   daemon.signal(SIGHUP);
   ASSERT_TRUE(test::eventually(
-      [&] { return count_of(test::DaemonProcess::read_file(events), "config_reloaded") == 1; }, 10s))
+      [&] { return count_of(test::DaemonProcess::read_file(events), "config_reloaded") == 1; },
+      10s))
       << daemon.log();
   write(cfg, config_text(dir, port, "{latching: true, rasie: 2}"));
   daemon.signal(SIGHUP);
   ASSERT_TRUE(test::eventually(
-      [&] { return count_of(test::DaemonProcess::read_file(events), "config_rejected") == 1; }, 10s))
+      [&] { return count_of(test::DaemonProcess::read_file(events), "config_rejected") == 1; },
+      10s))
       << daemon.log();
   EXPECT_NE(test::DaemonProcess::read_file(events).find("leakmon.yaml:6:29:"), std::string::npos)
       << "the rejection names file and line";
   EXPECT_TRUE(daemon.running());
-  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/metrics").body.find(
-                "leakmon_config_reload_success 0"),
+  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/metrics")
+                .body.find("leakmon_config_reload_success 0"),
             std::string::npos);
 
   // The leak raises the (latching) alarm; the operator acknowledges it over HTTP.
@@ -132,7 +137,8 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   const std::string log = daemon.log();
   std::smatch counts;
   ASSERT_TRUE(std::regex_search(
-      log, counts, std::regex(R"(stopped: (\d+) samples acquired, (\d+) processed, (\d+) dropped)")))
+      log, counts,
+      std::regex(R"(stopped: (\d+) samples acquired, (\d+) processed, (\d+) dropped)")))
       << log;
   const std::uint64_t acquired = std::stoull(counts[1]);
   EXPECT_GT(acquired, 0u);

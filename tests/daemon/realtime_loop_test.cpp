@@ -74,7 +74,8 @@ TEST(RealtimeLoop, AllocatesNothingOnItsThreadAndLosesNothing) {
     }
   });
   // Wait for enough cycles that the features, detector and sim have all been exercised.
-  while (loop.counters().cycles.load() < 600) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  while (loop.counters().cycles.load() < 600)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   stop.store(true);
   acquisition.join();
   stop_worker.store(true);

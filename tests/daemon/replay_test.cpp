@@ -88,8 +88,8 @@ TEST(Replay, NoAlarmOnHealthyCapturesOfEitherController) {
   for (auto [preset, seed] : {std::pair{"healthy", 21u}, std::pair{"healthy-ft", 22u}}) {
     const io::Capture capture = healthy_capture(seed, preset, 180.0);
     const auto result = replay_capture(capture, default_replay_config(capture));
-    EXPECT_TRUE(raised(result).empty()) << preset << " seed " << seed << ": false alarm at t="
-                                        << raised(result).front().t;
+    EXPECT_TRUE(raised(result).empty())
+        << preset << " seed " << seed << ": false alarm at t=" << raised(result).front().t;
   }
 }
 

@@ -11,8 +11,8 @@
 namespace leakmon::dsp {
 namespace {
 
-constexpr Mode kModes[] = {Mode::zero,     Mode::constant,      Mode::symmetric,
-                           Mode::reflect,  Mode::periodic,      Mode::smooth,
+constexpr Mode kModes[] = {Mode::zero,          Mode::constant,      Mode::symmetric,
+                           Mode::reflect,       Mode::periodic,      Mode::smooth,
                            Mode::periodization, Mode::antisymmetric, Mode::antireflect};
 
 std::vector<double> random_signal(std::size_t n, std::mt19937_64& rng) {
@@ -57,8 +57,9 @@ TEST(DwtOracle, WavedecMatchesPyWavelets) {
   for (const Case& c : cases) {
     const auto ours = wavedec(c.signal, wavelet(c.wavelet), c.mode, c.level);
     const auto& theirs = oracle.results(c.request);
-    const std::string label = c.wavelet + " " + std::string(mode_name(c.mode)) + " n=" +
-                              std::to_string(c.signal.size()) + " level " + std::to_string(c.level);
+    const std::string label = c.wavelet + " " + std::string(mode_name(c.mode)) +
+                              " n=" + std::to_string(c.signal.size()) + " level " +
+                              std::to_string(c.level);
     ASSERT_EQ(ours.size(), theirs.size()) << label;
     for (std::size_t a = 0; a < ours.size(); ++a) {
       ASSERT_EQ(ours[a].size(), theirs[a].size()) << label << " array " << a;

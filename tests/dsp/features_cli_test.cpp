@@ -63,9 +63,8 @@ TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
   const std::string dir = test::scratch_dir("features_cli_gaps");
   const std::vector<std::size_t> gaps = {450, 451, 1333};
   const auto p1 = write_capture(dir + "/in.csv", 2000, gaps);
-  const Outcome run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
-                                  "/features.csv",
-                              dir);
+  const Outcome run = run_leakmon(
+      "features --in " + dir + "/in.csv --channel p1 --out " + dir + "/features.csv", dir);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find(dir + "/features.csv"), std::string::npos) << run.output;
 
@@ -100,9 +99,9 @@ TEST(FeaturesCli, OptionsChooseWaveletLevelWindowStepAndMode) {
   const std::string dir = test::scratch_dir("features_cli_options");
   const auto p1 = write_capture(dir + "/in.csv", 900, {});
   const Outcome run = run_leakmon("features --in " + dir + "/in.csv --channel p1 --out " + dir +
-                                  "/f.csv --wavelet sym4 --level 3 --window 256 --step 30 "
-                                  "--mode periodization",
-                              dir);
+                                      "/f.csv --wavelet sym4 --level 3 --window 256 --step 30 "
+                                      "--mode periodization",
+                                  dir);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto lines = lines_of(dir + "/f.csv");
   const auto expected =
@@ -139,8 +138,8 @@ TEST(FeaturesCli, BadOptionsSayWhichAndWhy) {
 TEST(FeaturesCli, MalformedCaptureNamesFileLineAndColumn) {
   const std::string dir = test::scratch_dir("features_cli_malformed");
   std::ofstream(dir + "/bad.csv") << "# leakmon capture v1\nt,p1\n0,1\n0.002,oops\n";
-  const Outcome run = run_leakmon(
-      "features --in " + dir + "/bad.csv --channel p1 --out " + dir + "/f.csv", dir);
+  const Outcome run =
+      run_leakmon("features --in " + dir + "/bad.csv --channel p1 --out " + dir + "/f.csv", dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find(dir + "/bad.csv:4:2: column 'p1': 'oops' is not a number"),
             std::string::npos)

@@ -44,8 +44,10 @@ MatlabFile read_matlab_vectors() {
   MatlabFile file;
   std::string line;
   while (std::getline(in, line)) {
-    if (line.starts_with("# pywt db8 dec_lo:")) file.dec_lo = numbers_after(line.substr(11), "dec_lo:");
-    if (line.starts_with("# pywt db8 dec_hi:")) file.dec_hi = numbers_after(line.substr(11), "dec_hi:");
+    if (line.starts_with("# pywt db8 dec_lo:"))
+      file.dec_lo = numbers_after(line.substr(11), "dec_lo:");
+    if (line.starts_with("# pywt db8 dec_hi:"))
+      file.dec_hi = numbers_after(line.substr(11), "dec_hi:");
     if (!line.starts_with("CASE ")) continue;
     MatlabCase c;
     std::istringstream header(line.substr(5));
@@ -80,8 +82,8 @@ TEST(MatlabVectors, Db8AllModesBothFilterSets) {
   std::size_t builtin = 0;
   std::size_t pywt_filters = 0;
   for (const MatlabCase& c : file.cases) {
-    const std::string label = c.pywt_mode + "/" + c.matlab_mode + " n=" + std::to_string(c.n) +
-                              " " + c.coeffset;
+    const std::string label =
+        c.pywt_mode + "/" + c.matlab_mode + " n=" + std::to_string(c.n) + " " + c.coeffset;
     ASSERT_EQ(c.x.size(), c.n) << label;
     const DwtResult ours = dwt(c.x, db8, parse_mode(c.pywt_mode));
     ASSERT_EQ(ours.approx.size(), c.ca.size()) << label;

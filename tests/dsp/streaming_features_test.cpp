@@ -18,8 +18,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-constexpr Mode kModes[] = {Mode::zero,     Mode::constant,      Mode::symmetric,
-                           Mode::reflect,  Mode::periodic,      Mode::smooth,
+constexpr Mode kModes[] = {Mode::zero,          Mode::constant,      Mode::symmetric,
+                           Mode::reflect,       Mode::periodic,      Mode::smooth,
                            Mode::periodization, Mode::antisymmetric, Mode::antireflect};
 
 // channels x n samples, each channel a different random walk plus noise, with NaN gaps.
@@ -66,15 +66,14 @@ std::size_t check_stream_equals_batch(const FeatureParams& params,
   EXPECT_EQ(stream.incremental(), expect_incremental);
   std::vector<double> sample(channels);
   std::size_t window = 0;
-  const std::string label = params.wavelet + " " + std::string(mode_name(params.mode)) +
-                            " level " + std::to_string(params.level) + " window " +
-                            std::to_string(params.window) + " step " +
-                            std::to_string(params.step) + " channels " + std::to_string(channels);
+  const std::string label = params.wavelet + " " + std::string(mode_name(params.mode)) + " level " +
+                            std::to_string(params.level) + " window " +
+                            std::to_string(params.window) + " step " + std::to_string(params.step) +
+                            " channels " + std::to_string(channels);
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t c = 0; c < channels; ++c) sample[c] = x[c][i];
     const bool done = stream.push(sample);
-    const bool expected_done =
-        i + 1 >= params.window && (i + 1 - params.window) % params.step == 0;
+    const bool expected_done = i + 1 >= params.window && (i + 1 - params.window) % params.step == 0;
     EXPECT_EQ(done, expected_done) << label << " sample " << i;
     if (!done) continue;
     for (std::size_t c = 0; c < channels; ++c) {
@@ -107,7 +106,7 @@ TEST(StreamingFeatures, EveryModeSeveralWaveletsStepsAndChannelsEqualBatch) {
       {"db8", 2, 400, 7, 1, false},   {"haar", 1, 64, 2, 3, true},
       {"db4", 3, 256, 8, 2, true},    {"sym5", 2, 200, 12, 1, true},
       {"coif2", 2, 300, 40, 4, true}, {"db8", 4, 400, 32, 2, true},
-      {"db2", 1, 32, 500, 1, true},   // step longer than the window: samples in no window
+      {"db2", 1, 32, 500, 1, true},  // step longer than the window: samples in no window
       {"db20", 2, 400, 20, 2, true},
   };
   std::uint64_t seed = 10;

@@ -41,7 +41,8 @@ TEST(Wavelet, TapsSumsAndNormsAreThoseOfOrthogonalFilters) {
     EXPECT_EQ(w.dec_hi.size(), expected_taps) << name;
     const double lo_sum = std::accumulate(w.dec_lo.begin(), w.dec_lo.end(), 0.0);
     const double hi_sum = std::accumulate(w.dec_hi.begin(), w.dec_hi.end(), 0.0);
-    const double lo_norm = std::inner_product(w.dec_lo.begin(), w.dec_lo.end(), w.dec_lo.begin(), 0.0);
+    const double lo_norm =
+        std::inner_product(w.dec_lo.begin(), w.dec_lo.end(), w.dec_lo.begin(), 0.0);
     EXPECT_NEAR(lo_sum, std::sqrt(2.0), 1e-10) << name;
     EXPECT_NEAR(hi_sum, 0.0, 1e-10) << name;
     EXPECT_NEAR(lo_norm, 1.0, 1e-10) << name;

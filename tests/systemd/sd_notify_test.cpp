@@ -70,9 +70,9 @@ TEST(SdNotify, ReadyWatchdogReloadingStopping) {
 
   NotifySocket notify(dir + "/notify.sock");
   ASSERT_TRUE(notify.ok());
-  test::DaemonProcess daemon({"run", "--config", dir + "/leakmon.yaml"}, dir + "/daemon.log",
-                             {{"NOTIFY_SOCKET", dir + "/notify.sock"},
-                              {"WATCHDOG_USEC", "400000"}});
+  test::DaemonProcess daemon(
+      {"run", "--config", dir + "/leakmon.yaml"}, dir + "/daemon.log",
+      {{"NOTIFY_SOCKET", dir + "/notify.sock"}, {"WATCHDOG_USEC", "400000"}});
   ASSERT_TRUE(notify.wait_for("READY=1", 15s)) << daemon.log();
   EXPECT_NE(notify.messages.back().find("STATUS=running"), std::string::npos);
   ASSERT_TRUE(notify.wait_for("WATCHDOG=1", 5s)) << "no keep-alive while the loop runs";

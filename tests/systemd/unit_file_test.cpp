@@ -29,8 +29,8 @@ TEST(UnitFile, SystemdAnalyzeVerifyAcceptsIt) {
   const std::string dir = test::scratch_dir("unit_file_verify");
   std::string unit = test::DaemonProcess::read_file(unit_path());
   ASSERT_FALSE(unit.empty()) << unit_path();
-  const std::string installed_binary = unit.substr(unit.find("ExecStart=") + 10,
-                                                   unit.find(" run --config") - unit.find("ExecStart=") - 10);
+  const std::string installed_binary = unit.substr(
+      unit.find("ExecStart=") + 10, unit.find(" run --config") - unit.find("ExecStart=") - 10);
   for (auto pos = unit.find(installed_binary); pos != std::string::npos;
        pos = unit.find(installed_binary, pos + 1)) {
     unit.replace(pos, installed_binary.size(), test::leakmon_binary());
@@ -45,11 +45,10 @@ TEST(UnitFile, SystemdAnalyzeVerifyAcceptsIt) {
 
 TEST(UnitFile, KeepsTheRealTimeAndNotifyContract) {
   const std::string unit = test::DaemonProcess::read_file(unit_path());
-  for (const char* line :
-       {"Type=notify", "WatchdogSec=", "ExecReload=/bin/kill -HUP $MAINPID", "Restart=on-failure",
-        "NoNewPrivileges=yes", "ProtectSystem=strict",
-        "CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK", "LimitRTPRIO=", "LimitMEMLOCK=",
-        "AF_CAN"}) {
+  for (const char* line : {"Type=notify", "WatchdogSec=", "ExecReload=/bin/kill -HUP $MAINPID",
+                           "Restart=on-failure", "NoNewPrivileges=yes", "ProtectSystem=strict",
+                           "CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK",
+                           "LimitRTPRIO=", "LimitMEMLOCK=", "AF_CAN"}) {
     EXPECT_NE(unit.find(line), std::string::npos) << "missing " << line;
   }
   EXPECT_EQ(unit.find("notify-reload"), std::string::npos) << "systemd 252 has no notify-reload";

@@ -90,8 +90,7 @@ TEST(Capture, EmptyFieldsAndNanAreGapsNotZeros) {
 
 TEST(Capture, UnknownColumnsAreKeptInAnyOrder) {
   const std::string dir = test::scratch_dir("capture_unknown");
-  const std::string path =
-      write_file(dir, "c.csv", "p2,t,coolant_temp\n4,0,21.5\n5,0.002,21.6\n");
+  const std::string path = write_file(dir, "c.csv", "p2,t,coolant_temp\n4,0,21.5\n5,0.002,21.6\n");
   const Capture c = read_capture(path);
   EXPECT_EQ(c.columns, (std::vector<std::string>{"p2", "t", "coolant_temp"}));
   EXPECT_EQ(c.column("coolant_temp")[1], 21.6);

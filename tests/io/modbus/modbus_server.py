@@ -107,23 +107,33 @@ def parse_map(spec):
     return entries
 
 
-async def follow_capture(slave, args):
-    columns, rows = read_capture(args.capture)
-    entries = parse_map(args.map)
-    period = 1.0 / args.rate
-    start = time.monotonic()
-    index = 0
-    while True:
-        row = rows[index % len(rows)]
-        for name, function, address, data_type, order, scale, offset in entries:
-            value = index if name.startswith("index") else row[columns.index(name)]
+class CaptureFollower:
+    """Serves row `index % rows` of the capture; the next row every 1/rate seconds."""
+
+    def __init__(self, slave, args):
+        self.slave = slave
+        self.columns, self.rows = read_capture(args.capture)
+        self.entries = parse_map(args.map)
+        self.period = 1.0 / args.rate
+
+    def serve(self, index):
+        # No await in here: a request never sees half a row.
+        row = self.rows[index % len(self.rows)]
+        for name, function, address, data_type, order, scale, offset in self.entries:
+            value = index if name.startswith("index") else row[self.columns.index(name)]
             raw = (value - offset) / scale
             if function in (1, 2):
-                slave.setValues(function, address, [bool(round(raw))])
+                self.slave.setValues(function, address, [bool(round(raw))])
             else:
-                slave.setValues(function, address, encode(raw, data_type, order))
-        index += 1
-        await asyncio.sleep(max(0.0, start + index * period - time.monotonic()))
+                self.slave.setValues(function, address, encode(raw, data_type, order))
+
+    async def run(self):
+        start = time.monotonic()
+        index = 0
+        while True:
+            index += 1
+            await asyncio.sleep(max(0.0, start + index * self.period - time.monotonic()))
+            self.serve(index)
 
 
 async def serve_garbage(args):
@@ -154,7 +164,9 @@ async def main(args):
     loop.add_signal_handler(signal.SIGUSR1, lambda: setattr(slave, "slow", not slave.slow))
     loop.add_signal_handler(signal.SIGUSR2, lambda: setattr(slave, "refuse", not slave.refuse))
     if args.capture:
-        asyncio.create_task(follow_capture(slave, args))
+        follower = CaptureFollower(slave, args)
+        follower.serve(0)  # before the first request can arrive
+        asyncio.create_task(follower.run())
     if args.serial:
         server = ModbusSerialServer(context, framer=ModbusRtuFramer, port=args.serial,
                                     baudrate=args.baud, parity=args.parity, bytesize=8,

@@ -12,13 +12,16 @@ namespace leakmon::test {
 
 class ChildProcess {
  public:
-  explicit ChildProcess(const std::vector<std::string>& argv);
+  // `log`: file for the child's stdout and stderr; empty keeps the test's.
+  explicit ChildProcess(const std::vector<std::string>& argv, const std::string& log = "");
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
 
   void send(int signal) const;
   void kill_and_wait();  // SIGKILL: the peer vanishes without closing anything politely
+  // Sends `signal` and waits up to `seconds` for the exit; the exit code, or -1 (then killed).
+  int stop_and_wait(int signal, double seconds);
   bool running() const { return pid_ > 0; }
 
  private:

@@ -86,7 +86,13 @@ void ServedCapture::check(std::int64_t tick_ns, std::span<const double> values,
 
   const auto rows = p1_.size();
   const auto mismatch = [&](double got, double want) {
-    if (!std::isnan(got) && got != want) ++tally.mismatches;
+    if (!std::isnan(got) && got != want) {
+      if (tally.mismatches == 0)
+        tally.first_mismatch = "got " + std::to_string(got) + ", served " + std::to_string(want) +
+                               " (index_h " + std::to_string(values[kIndexH]) + ", index_i " +
+                               std::to_string(values[kIndexI]) + ")";
+      ++tally.mismatches;
+    }
   };
   // One request carries index_h, p1, p2 and x: they are from the same capture row.
   if (!std::isnan(values[kIndexH])) {
@@ -99,15 +105,20 @@ void ServedCapture::check(std::int64_t tick_ns, std::span<const double> values,
       bool near = false;
       for (std::size_t d = 0; d < 11; ++d)
         near |= valve_[(row + rows + d - 5) % rows] == values[kValve];
-      if (!near) ++tally.mismatches;
+      if (!near) {
+        if (tally.mismatches == 0) tally.first_mismatch = "valve far from its row";
+        ++tally.mismatches;
+      }
     }
   } else if (!std::isnan(values[kP1]) || !std::isnan(values[kP2]) || !std::isnan(values[kX])) {
+    if (tally.mismatches == 0) tally.first_mismatch = "holding values without their index";
     ++tally.mismatches;  // values of one request are fresh or stale together
   }
   if (!std::isnan(values[kIndexI])) {
     const auto row = static_cast<std::size_t>(values[kIndexI]) % rows;
     mismatch(values[kU], u_[row]);
   } else if (!std::isnan(values[kU])) {
+    if (tally.mismatches == 0) tally.first_mismatch = "input values without their index";
     ++tally.mismatches;
   }
 }

@@ -29,6 +29,7 @@ class ServedCapture {
     std::uint64_t fresh = 0;        // ticks where every channel had a value
     std::uint64_t gaps = 0;         // ticks where some channel was a gap
     std::uint64_t mismatches = 0;   // values that differ from the served capture row: must be 0
+    std::string first_mismatch;     // what the first mismatch was, for the failure message
     std::uint64_t allocations = 0;  // heap allocations inside Driver::read: must be 0
     std::uint64_t values_after_deadline = 0;  // non-gap values read after `deadline_ns`
   };

@@ -55,8 +55,8 @@ TEST_F(ModbusTcp, SamplesEqualTheServedCaptureAfterScaling) {
   ASSERT_TRUE(capture_.run_until_fresh(*driver, 10, 15.0, warmup));
 
   const auto tally = capture_.run(*driver, 1.5);
-  EXPECT_EQ(tally.mismatches, 0U);
-  EXPECT_EQ(warmup.mismatches, 0U);
+  EXPECT_EQ(tally.mismatches, 0U) << tally.first_mismatch;
+  EXPECT_EQ(warmup.mismatches, 0U) << warmup.first_mismatch;
   EXPECT_EQ(tally.allocations, 0U);
   // Most ticks see fresh values; the rest are gaps, never stale or wrong numbers.
   EXPECT_GT(tally.fresh, tally.ticks / 4);
@@ -91,7 +91,9 @@ TEST_F(ModbusTcp, ServerKilledAndRestartedGivesGapsThenRecovers) {
   ServedCapture::Tally after;
   ASSERT_TRUE(capture_.run_until_fresh(*driver, 10, 15.0, after));
   const auto settled = capture_.run(*driver, 0.5);
-  EXPECT_EQ(before.mismatches + outage.mismatches + after.mismatches + settled.mismatches, 0U);
+  EXPECT_EQ(before.mismatches + outage.mismatches + after.mismatches + settled.mismatches, 0U)
+      << before.first_mismatch << outage.first_mismatch << after.first_mismatch
+      << settled.first_mismatch;
   EXPECT_GT(settled.fresh, 0U);
   health = driver->health();
   EXPECT_EQ(health.state, "ok");
@@ -121,7 +123,9 @@ TEST_F(ModbusTcp, SlowServerTimesOutReconnectsAndNeverMixesUpAnswers) {
   ASSERT_TRUE(capture_.run_until_fresh(*driver, 10, 15.0, after));
   // Late answers to abandoned requests must not be taken for new ones.
   const auto settled = capture_.run(*driver, 0.5);
-  EXPECT_EQ(before.mismatches + slow.mismatches + after.mismatches + settled.mismatches, 0U);
+  EXPECT_EQ(before.mismatches + slow.mismatches + after.mismatches + settled.mismatches, 0U)
+      << before.first_mismatch << slow.first_mismatch << after.first_mismatch
+      << settled.first_mismatch;
   EXPECT_GE(driver->health().reconnects, 1U);
 }
 
@@ -146,7 +150,8 @@ TEST_F(ModbusTcp, ExceptionRepliesGiveGapsAndKeepTheConnection) {
   server.toggle_exceptions();
   ServedCapture::Tally after;
   ASSERT_TRUE(capture_.run_until_fresh(*driver, 10, 15.0, after));
-  EXPECT_EQ(before.mismatches + refused.mismatches + after.mismatches, 0U);
+  EXPECT_EQ(before.mismatches + refused.mismatches + after.mismatches, 0U)
+      << before.first_mismatch << refused.first_mismatch << after.first_mismatch;
   health = driver->health();
   EXPECT_EQ(health.state, "ok");
   EXPECT_EQ(health.reconnects, 0U);

@@ -1,0 +1,43 @@
+// Speed of the model check (issue 7 target: a 120 s capture diagnosed in <= 10 s on one core).
+// The capture is simulated once (internal leakage hidden, fixed seed), then diagnosed.
+#include <benchmark/benchmark.h>
+
+#include "model/diagnosis.hpp"
+#include "model/synthetic_case.hpp"
+
+namespace {
+
+using namespace leakmon::model;
+
+const MeasuredRecord& capture_120s() {
+  static const MeasuredRecord record =
+      measured_record(simulate_case(draw_case(7, "internal_leakage", {120.0})));
+  return record;
+}
+
+void BM_ModelCheck120s(benchmark::State& state) {
+  const MeasuredRecord& record = capture_120s();
+  for (auto _ : state) {
+    Diagnosis d = diagnose(record);
+    benchmark::DoNotOptimize(d);
+  }
+}
+BENCHMARK(BM_ModelCheck120s)->Unit(benchmark::kSecond)->Iterations(3)->UseRealTime();
+
+// One residual evaluation of the fitting set (24 segments of 0.5 s): the solver's unit of work.
+void BM_FittingResiduals(benchmark::State& state) {
+  const MeasuredRecord& record = capture_120s();
+  const SegmentPredictor predictor(record);
+  const auto segments = spread(split_record(record).fitting, 24);
+  std::vector<double> residuals(SegmentPredictor::residual_count(segments));
+  const ModelParameters parameters;
+  for (auto _ : state) {
+    predictor.residuals(parameters, segments, residuals);
+    benchmark::DoNotOptimize(residuals.data());
+  }
+}
+BENCHMARK(BM_FittingResiduals)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
