@@ -7,8 +7,8 @@
 namespace leakmon::model {
 namespace {
 
-constexpr double kAtmosphere = 101325.0;  // p_a of the entrained-air law
-constexpr double kPolytropic = 1.4;       // n
+constexpr double kAtmosphere = 101325.0;    // p_a of the entrained-air law
+constexpr double kPolytropic = 1.4;         // n
 constexpr double kFrictionVelocity = 1e-3;  // tanh(v / 1e-3) of coulomb_friction
 constexpr int kMaxSubsteps = 16;            // per sample: bounds the cost of stiff friction
 
@@ -28,8 +28,7 @@ double orifice_slope(double dp, double dp_lin) {
 ActuatorModel::ActuatorModel(const ModelParameters& parameters, const RigConstants& rig)
     : parameters_(parameters),
       rig_(rig),
-      spool_tau_(parameters.effects.spool_tau > 0.0 ? parameters.effects.spool_tau
-                                                    : rig.spool_tau),
+      spool_tau_(parameters.effects.spool_tau > 0.0 ? parameters.effects.spool_tau : rig.spool_tau),
       half_volume_(rig.half_volume()) {}
 
 int ActuatorModel::substeps(double dt) const {
@@ -139,8 +138,8 @@ ActuatorState ActuatorModel::derivative(const ActuatorState& s, double spool_in,
   if (e.F_C != 0.0) force -= e.F_C * std::tanh(s.v / v_fric);
   const double half_stroke = r.stroke / 2.0;
   if (std::abs(s.x) > half_stroke) {
-    force -= r.end_stop_stiffness * (s.x - std::copysign(half_stroke, s.x)) +
-             r.end_stop_damping * s.v;
+    force -=
+        r.end_stop_stiffness * (s.x - std::copysign(half_stroke, s.x)) + r.end_stop_damping * s.v;
   }
   d.v = force / c.m;
   if (e.tau_s > 0.0) {
@@ -153,7 +152,7 @@ ActuatorState ActuatorModel::derivative(const ActuatorState& s, double spool_in,
 namespace {
 
 ActuatorState axpy(const ActuatorState& a, double h, const ActuatorState& d) {
-  return {a.xs + h * d.xs, a.x + h * d.x, a.v + h * d.v,
+  return {a.xs + h * d.xs, a.x + h * d.x,   a.v + h * d.v,
           a.p1 + h * d.p1, a.p2 + h * d.p2, a.s + h * d.s};
 }
 

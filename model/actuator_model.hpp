@@ -14,7 +14,7 @@ struct ActuatorState {
   double v = 0.0;   // piston velocity [m/s]
   double p1 = 0.0;  // true chamber pressures [Pa]
   double p2 = 0.0;
-  double s = 0.0;   // reading of the lagging transducer (sensor_lag) [Pa]
+  double s = 0.0;  // reading of the lagging transducer (sensor_lag) [Pa]
 };
 
 // What the instruments report for a state: position and the two pressure readings.
@@ -46,8 +46,7 @@ class ActuatorModel {
   double bulk_modulus(double p) const;
 
  private:
-  ActuatorState derivative(const ActuatorState& s, double spool_in, double t,
-                           double v_fric) const;
+  ActuatorState derivative(const ActuatorState& s, double spool_in, double t, double v_fric) const;
   double friction_velocity(double h) const;
   double opening(double xs) const;
 

@@ -72,9 +72,9 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
 
   int operator()(const InputType& theta, ValueType& residuals) const {
     ++evaluations_;
-    predictor_.residuals(model(theta), segments_,
-                         std::span<double>(residuals.data(), static_cast<std::size_t>(
-                                                                 residuals.size())));
+    predictor_.residuals(
+        model(theta), segments_,
+        std::span<double>(residuals.data(), static_cast<std::size_t>(residuals.size())));
     return 0;
   }
 
@@ -136,9 +136,9 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
     const Eigen::MatrixXd info = jacobian.transpose() * jacobian;
     const Eigen::MatrixXd cov = s2 * info.completeOrthogonalDecomposition().pseudoInverse();
     const auto err = [&](int j) { return std::sqrt(std::max(cov(j, j), 0.0)); };
-    double* errors[kCalibrationCount] = {&result.calibration_errors.beta,
-                                         &result.calibration_errors.Kv,
-                                         &result.calibration_errors.m, &result.calibration_errors.b};
+    double* errors[kCalibrationCount] = {
+        &result.calibration_errors.beta, &result.calibration_errors.Kv,
+        &result.calibration_errors.m, &result.calibration_errors.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       const int slot = problem.calibration_slot(i);
       *errors[i] = slot >= 0 ? err(slot) * kScales[i] : 0.0;

@@ -15,17 +15,17 @@ namespace leakmon::model {
 using CalibrationMask = std::array<bool, 4>;  // beta, Kv, m, b
 
 struct FitSettings {
-  int max_iterations = 15;  // solver steps (each with a Jacobian: one simulation per unknown)
-  bool uncertainties = false; // also compute standard errors (one more Jacobian)
+  int max_iterations = 15;     // solver steps (each with a Jacobian: one simulation per unknown)
+  bool uncertainties = false;  // also compute standard errors (one more Jacobian)
   CalibrationMask free_calibration = {true, true, true, true};  // others stay at `start`
 };
 
 struct FitResult {
-  ModelParameters parameters;         // the fitted model
-  std::vector<double> values;         // the candidate's parameters [SI], clamped as applied
-  std::vector<double> value_errors;   // their standard errors (when requested), same order
-  Calibration calibration_errors;     // standard errors of beta, Kv, m, b (when requested)
-  double cost = 0.0;                  // mean squared scaled residual on the fitting segments
+  ModelParameters parameters;        // the fitted model
+  std::vector<double> values;        // the candidate's parameters [SI], clamped as applied
+  std::vector<double> value_errors;  // their standard errors (when requested), same order
+  Calibration calibration_errors;    // standard errors of beta, Kv, m, b (when requested)
+  double cost = 0.0;                 // mean squared scaled residual on the fitting segments
   int evaluations = 0;
 };
 

@@ -65,7 +65,8 @@ std::vector<NamedValue> named_values(const EffectCandidate& c, const FitResult& 
     out.push_back({c.parameters[i].name, fit.values[i],
                    fit.value_errors.empty() ? 0.0 : fit.value_errors[i], ""});
   }
-  if (c.effect == "external_leakage") out.push_back({"chamber", c.variant == "chamber 2" ? 2.0 : 1.0, 0.0, ""});
+  if (c.effect == "external_leakage")
+    out.push_back({"chamber", c.variant == "chamber 2" ? 2.0 : 1.0, 0.0, ""});
   if (c.effect == "sensor_offset" || c.effect == "sensor_lag") {
     out.push_back({"channel", 0.0, 0.0, c.variant});
   }
@@ -87,8 +88,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   d.held_out_used = spread(d.plan.held_out, settings.max_held_out_segments);
   const SegmentPredictor predictor(record);
 
-  const FitResult nominal = fit_model(predictor, d.fitting_used, nullptr, Calibration{},
-                                      settings.fit);
+  const FitResult nominal =
+      fit_model(predictor, d.fitting_used, nullptr, Calibration{}, settings.fit);
   d.nominal = nominal.parameters;
   const std::vector<double> nominal_errors =
       segment_errors(predictor, nominal.parameters, d.held_out_used);
@@ -119,8 +120,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     screening.free_calibration = {true, true, true, true};
     // From the catalogue calibration, not the nominal fit: a large effect distorts the
     // nominal fit, which then leads the solver into a compensating local minimum.
-    RankedEffect r = score(candidate, fit_model(predictor, screening_segments, &candidate,
-                                                Calibration{}, screening));
+    RankedEffect r = score(
+        candidate, fit_model(predictor, screening_segments, &candidate, Calibration{}, screening));
     auto it = best.find(candidate.effect);
     if (it == best.end() || r.score > it->second.score) {
       best[candidate.effect] = std::move(r);
@@ -131,9 +132,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // segment, from their screening values.
   std::vector<std::string> leaders;
   for (const auto& [name, r] : best) leaders.push_back(name);
-  std::stable_sort(leaders.begin(), leaders.end(), [&](const auto& a, const auto& b) {
-    return best[a].score > best[b].score;
-  });
+  std::stable_sort(leaders.begin(), leaders.end(),
+                   [&](const auto& a, const auto& b) { return best[a].score > best[b].score; });
   leaders.resize(std::min(leaders.size(), settings.refined_effects));
   for (const auto& name : leaders) {
     if (best[name].score <= 0.0) continue;
@@ -142,9 +142,9 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
       auto& fp = candidate.parameters[i];
       fp.initial = std::clamp(best[name].fit.values[i], fp.lower, fp.upper);
     }
-    RankedEffect refined = score(candidate, fit_model(predictor, d.fitting_used, &candidate,
-                                                      best[name].fit.parameters.calibration,
-                                                      settings.fit));
+    RankedEffect refined =
+        score(candidate, fit_model(predictor, d.fitting_used, &candidate,
+                                   best[name].fit.parameters.calibration, settings.fit));
     refined.refined = true;
     best[name] = std::move(refined);
   }
@@ -187,8 +187,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     d.calibrated = fit.parameters.calibration;
     d.calibrated_errors = fit.calibration_errors;
   } else {
-    const FitResult fit = fit_model(predictor, d.fitting_used, nullptr,
-                                    nominal.parameters.calibration, with_errors);
+    const FitResult fit =
+        fit_model(predictor, d.fitting_used, nullptr, nominal.parameters.calibration, with_errors);
     d.calibrated_errors = fit.calibration_errors;
   }
   d.nrmse_after = predictor.nrmse(d.extended, d.held_out_used);

@@ -14,19 +14,19 @@
 namespace leakmon::model {
 
 struct NamedValue {
-  std::string name;      // MODEL.md's parameter name
-  double value = 0.0;    // SI
-  double error = 0.0;    // standard error, 0 when not computed
-  std::string text;      // non-empty for discrete parameters ("p2"), which then have no value
+  std::string name;    // MODEL.md's parameter name
+  double value = 0.0;  // SI
+  double error = 0.0;  // standard error, 0 when not computed
+  std::string text;    // non-empty for discrete parameters ("p2"), which then have no value
   bool is_text() const { return !text.empty(); }
 };
 
 struct RankedEffect {
   std::string effect;
-  double score = 0.0;     // share of the nominal model's held-out squared error it removes
+  double score = 0.0;         // share of the nominal model's held-out squared error it removes
   double significance = 0.0;  // paired t statistic of the held-out per-segment improvement
-  bool plausible = false; // fitted main parameter is a physical instance of the effect
-  bool refined = false;   // fitted with the calibration on all fitting segments
+  bool plausible = false;     // fitted main parameter is a physical instance of the effect
+  bool refined = false;       // fitted with the calibration on all fitting segments
   std::vector<NamedValue> params;
   FitResult fit;
 };
@@ -48,15 +48,15 @@ struct DiagnosisSettings {
 
 struct Diagnosis {
   std::string cause = "none";
-  std::vector<NamedValue> params;      // the cause's parameters with standard errors
-  Calibration calibrated;              // of the reported model (the cause's fit, or nominal)
+  std::vector<NamedValue> params;  // the cause's parameters with standard errors
+  Calibration calibrated;          // of the reported model (the cause's fit, or nominal)
   Calibration calibrated_errors;
-  std::vector<RankedEffect> ranking;   // every effect, best first
-  double nrmse_before = 0.0;           // held-out, calibrated nominal model
-  double nrmse_after = 0.0;            // held-out, model extended with the cause
+  std::vector<RankedEffect> ranking;  // every effect, best first
+  double nrmse_before = 0.0;          // held-out, calibrated nominal model
+  double nrmse_after = 0.0;           // held-out, model extended with the cause
   SegmentPlan plan;
   std::vector<Segment> fitting_used, held_out_used;
-  ModelParameters nominal, extended;   // the two models compared
+  ModelParameters nominal, extended;  // the two models compared
   std::optional<double> ripple_line_hz;
 };
 

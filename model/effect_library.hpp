@@ -21,8 +21,8 @@ struct FreeParameter {
 };
 
 struct EffectCandidate {
-  std::string effect;   // MODEL.md's name
-  std::string variant;  // "chamber 2", "p1", ... ; empty when the effect has none
+  std::string effect;                     // MODEL.md's name
+  std::string variant;                    // "chamber 2", "p1", ... ; empty when the effect has none
   std::vector<FreeParameter> parameters;  // the first one is the effect's main parameter
   // Calibration parameters (beta, Kv, m, b) whose effect on the signals resembles this one's:
   // screening frees them too, or the calibration would already have absorbed the effect.

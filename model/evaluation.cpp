@@ -43,12 +43,13 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
 }
 
 std::string EvaluationSummary::csv() const {
-  std::string out = "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
-                    "nrmse_after,seconds\n";
+  std::string out =
+      "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
+      "nrmse_after,seconds\n";
   for (const auto& c : cases) {
-    out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f}\n", c.seed, c.truth,
-                       c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
-                       c.nrmse_after, c.seconds);
+    out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f}\n", c.seed, c.truth, c.named,
+                       c.main_parameter, c.true_value, c.estimate, c.nrmse_before, c.nrmse_after,
+                       c.seconds);
   }
   return out;
 }
@@ -69,11 +70,14 @@ std::string EvaluationSummary::markdown() const {
     }
     slowest = std::max(slowest, c.seconds);
   }
-  const auto pct = [](int a, std::size_t b) { return b ? 100.0 * a / static_cast<double>(b) : 0.0; };
+  const auto pct = [](int a, std::size_t b) {
+    return b ? 100.0 * a / static_cast<double>(b) : 0.0;
+  };
   std::string out;
-  out += fmt::format("| cases | cause named correctly | main parameter within 25 % (none: "
-                     "named none) | held-out NRMSE halved when a cause is named | slowest "
-                     "diagnosis |\n|---|---|---|---|---|\n");
+  out += fmt::format(
+      "| cases | cause named correctly | main parameter within 25 % (none: "
+      "named none) | held-out NRMSE halved when a cause is named | slowest "
+      "diagnosis |\n|---|---|---|---|---|\n");
   out += fmt::format("| {} | {:.1f} % | {:.1f} % | {:.1f} % ({} of {}) | {:.2f} s |\n\n",
                      cases.size(), pct(named_ok, cases.size()), pct(param_ok, cases.size()),
                      pct(halved, static_cast<std::size_t>(named_causes)), halved, named_causes,

@@ -18,7 +18,7 @@ struct CaseOutcome {
   std::string main_parameter;
   double true_value = 0.0, estimate = 0.0;  // main parameter; estimate 0 when not named
   double nrmse_before = 0.0, nrmse_after = 0.0;
-  double seconds = 0.0;                      // diagnosis wall time
+  double seconds = 0.0;  // diagnosis wall time
   bool named_correctly() const { return truth == named; }
   bool parameter_within(double tolerance) const;
 };

@@ -24,9 +24,10 @@ struct RowOrigin {
 MeasuredRecord vet(MeasuredRecord rec, const RowOrigin& origin, const RecordRequirements& req) {
   const std::size_t n = rec.size();
   if (n < 3) {
-    throw ModelCheckError(fmt::format("{}: capture holds {} samples; the model check needs at "
-                                      "least {} s of data",
-                                      rec.source, n, req.min_duration_s));
+    throw ModelCheckError(
+        fmt::format("{}: capture holds {} samples; the model check needs at "
+                    "least {} s of data",
+                    rec.source, n, req.min_duration_s));
   }
   // The sample period is the median step; every step must match it (regular sampling).
   std::vector<double> steps(n - 1);
@@ -82,9 +83,10 @@ void require_columns(const std::vector<std::string>& columns, const std::string&
   if (!missing.empty()) {
     std::string header;
     for (const auto& c : columns) header += (header.empty() ? "" : ",") + c;
-    throw ModelCheckError(fmt::format("{}: header '{}' lacks column(s) {}; the model check needs "
-                                      "t,u,x,p1,p2",
-                                      source, header, missing));
+    throw ModelCheckError(
+        fmt::format("{}: header '{}' lacks column(s) {}; the model check needs "
+                    "t,u,x,p1,p2",
+                    source, header, missing));
   }
 }
 

@@ -19,7 +19,7 @@ class ModelCheckError : public std::runtime_error {
 };
 
 struct MeasuredRecord {
-  std::string source;     // file the data came from
+  std::string source;      // file the data came from
   std::string controller;  // "basic", "fault_tolerant" or "" when the capture does not say
   double dt = 0.002;       // sample period [s]
   std::vector<double> t, u, x, p1, p2;
@@ -32,8 +32,8 @@ struct MeasuredRecord {
 
 struct RecordRequirements {
   double min_duration_s = 20.0;
-  double max_gap_fraction = 0.02;   // refuse when more samples than this are missing
-  double rate_tolerance = 0.01;     // relative deviation of any t step from the period
+  double max_gap_fraction = 0.02;  // refuse when more samples than this are missing
+  double rate_tolerance = 0.01;    // relative deviation of any t step from the period
 };
 
 // Reads and vets a capture file. Throws io::CaptureError for malformed CSV (file:line:column)

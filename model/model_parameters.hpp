@@ -7,30 +7,30 @@
 namespace leakmon::model {
 
 struct Calibration {
-  double beta = 700e6;   // effective bulk modulus [Pa]
-  double Kv = 3.39e-7;   // valve coefficient [m^3/(s sqrt(Pa))]
-  double m = 10.0;       // moving mass [kg]
-  double b = 300.0;      // viscous friction [N s/m]
+  double beta = 700e6;  // effective bulk modulus [Pa]
+  double Kv = 3.39e-7;  // valve coefficient [m^3/(s sqrt(Pa))]
+  double m = 10.0;      // moving mass [kg]
+  double b = 300.0;     // viscous friction [N s/m]
 };
 
 enum class PressureChannel { p1, p2 };
 
 struct EffectParameters {
-  double C_L = 0.0;                            // internal_leakage [m^3/(s Pa)]
-  double C_E = 0.0;                            // external_leakage [m^3/(s Pa)]
-  int external_chamber = 1;                    //   ... its chamber, 1 or 2
-  double F_C = 0.0;                            // coulomb_friction [N]
-  double alpha = 0.0;                          // entrained_air, free-air fraction
-  double d = 0.0;                              // valve_overlap, fraction of spool travel
-  double u0 = 0.0;                             // valve_bias [V]
-  double spool_tau = 0.0;                      // spool_lag: true tau [s]; 0 = nominal
-  double ripple_dP = 0.0;                      // supply_ripple amplitude [Pa] (sin term)
-  double ripple_dQ = 0.0;                      //   ... cos term: phase freedom while fitting
-  double ripple_f = 0.0;                       //   ... frequency [Hz]
-  double R_s = 0.0;                            // supply_droop [Pa s/m^3]
-  double offset = 0.0;                         // sensor_offset [Pa]
+  double C_L = 0.0;          // internal_leakage [m^3/(s Pa)]
+  double C_E = 0.0;          // external_leakage [m^3/(s Pa)]
+  int external_chamber = 1;  //   ... its chamber, 1 or 2
+  double F_C = 0.0;          // coulomb_friction [N]
+  double alpha = 0.0;        // entrained_air, free-air fraction
+  double d = 0.0;            // valve_overlap, fraction of spool travel
+  double u0 = 0.0;           // valve_bias [V]
+  double spool_tau = 0.0;    // spool_lag: true tau [s]; 0 = nominal
+  double ripple_dP = 0.0;    // supply_ripple amplitude [Pa] (sin term)
+  double ripple_dQ = 0.0;    //   ... cos term: phase freedom while fitting
+  double ripple_f = 0.0;     //   ... frequency [Hz]
+  double R_s = 0.0;          // supply_droop [Pa s/m^3]
+  double offset = 0.0;       // sensor_offset [Pa]
   PressureChannel offset_channel = PressureChannel::p1;
-  double tau_s = 0.0;                          // sensor_lag [s]
+  double tau_s = 0.0;  // sensor_lag [s]
   PressureChannel lag_channel = PressureChannel::p1;
 };
 

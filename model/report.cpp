@@ -25,10 +25,11 @@ std::string residual_csv(const MeasuredRecord& r, const Diagnosis& d) {
   std::string out = "t,u,x,p1,p2,x_before,p1_before,p2_before,x_after,p1_after,p2_after\n";
   for (const auto& seg : d.held_out_used) {
     for (std::size_t k = seg.begin + 1; k < seg.begin + seg.length; ++k) {
-      out += fmt::format("{:.4f},{:.5g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},"
-                         "{:.7g}\n",
-                         r.t[k], r.u[k], r.x[k], r.p1[k], r.p2[k], before.x[k], before.p1[k],
-                         before.p2[k], after.x[k], after.p1[k], after.p2[k]);
+      out += fmt::format(
+          "{:.4f},{:.5g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},"
+          "{:.7g}\n",
+          r.t[k], r.u[k], r.x[k], r.p1[k], r.p2[k], before.x[k], before.p1[k], before.p2[k],
+          after.x[k], after.p1[k], after.p2[k]);
     }
   }
   return out;
@@ -50,54 +51,63 @@ std::string parameter_lines(const std::vector<NamedValue>& params) {
 
 std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
   std::string out = fmt::format("# Model check of {}\n\n", r.source);
-  out += fmt::format("{:.1f} s at {:.0f} Hz; the model was fitted on {} segments of the fitting "
-                     "part and scored on {} held-out segments (open-loop simulation on the "
-                     "measured command from the measured state, see docs/model-check.md).\n\n",
-                     r.duration(), 1.0 / r.dt, d.fitting_used.size(), d.held_out_used.size());
+  out += fmt::format(
+      "{:.1f} s at {:.0f} Hz; the model was fitted on {} segments of the fitting "
+      "part and scored on {} held-out segments (open-loop simulation on the "
+      "measured command from the measured state, see docs/model-check.md).\n\n",
+      r.duration(), 1.0 / r.dt, d.fitting_used.size(), d.held_out_used.size());
   out += "## Verdict\n\n";
   if (d.cause == "none") {
-    out += "No effect of the library predicts the held-out data significantly better than the "
-           "calibrated nominal model: the simulation agrees with the measurement within the "
-           "noise (the spool flow noise is process noise, not a discrepancy).\n\n";
+    out +=
+        "No effect of the library predicts the held-out data significantly better than the "
+        "calibrated nominal model: the simulation agrees with the measurement within the "
+        "noise (the spool flow noise is process noise, not a discrepancy).\n\n";
   } else {
-    out += fmt::format("The nominal model misses **{}**. Extending the model with it lowers the "
-                       "held-out NRMSE from {:.4f} to {:.4f}.\n\n",
-                       d.cause, d.nrmse_before, d.nrmse_after);
+    out += fmt::format(
+        "The nominal model misses **{}**. Extending the model with it lowers the "
+        "held-out NRMSE from {:.4f} to {:.4f}.\n\n",
+        d.cause, d.nrmse_before, d.nrmse_after);
     out += "| parameter | fitted value | standard error |\n|---|---|---|\n";
     out += parameter_lines(d.params) + "\n";
   }
-  out += "## Calibration (fitted, not a cause)\n\n| parameter | value | standard error |\n"
-         "|---|---|---|\n";
+  out +=
+      "## Calibration (fitted, not a cause)\n\n| parameter | value | standard error |\n"
+      "|---|---|---|\n";
   const auto& c = d.calibrated;
   const auto& e = d.calibrated_errors;
-  out += fmt::format("| beta | {:.4g} Pa | {:.2g} |\n| Kv | {:.4g} | {:.2g} |\n| m | {:.4g} kg | "
-                     "{:.2g} |\n| b | {:.4g} N s/m | {:.2g} |\n\n",
-                     c.beta, e.beta, c.Kv, e.Kv, c.m, e.m, c.b, e.b);
-  out += "Standard errors come from the Gauss-Newton covariance of the fit; residuals within a "
-         "segment are correlated, so they are optimistic.\n\n";
-  out += "## Ranking of the effect library (held-out data)\n\n| effect | score | significance "
-         "(t) | physical | parameters |\n|---|---|---|---|---|\n";
+  out += fmt::format(
+      "| beta | {:.4g} Pa | {:.2g} |\n| Kv | {:.4g} | {:.2g} |\n| m | {:.4g} kg | "
+      "{:.2g} |\n| b | {:.4g} N s/m | {:.2g} |\n\n",
+      c.beta, e.beta, c.Kv, e.Kv, c.m, e.m, c.b, e.b);
+  out +=
+      "Standard errors come from the Gauss-Newton covariance of the fit; residuals within a "
+      "segment are correlated, so they are optimistic.\n\n";
+  out +=
+      "## Ranking of the effect library (held-out data)\n\n| effect | score | significance "
+      "(t) | physical | parameters |\n|---|---|---|---|---|\n";
   for (const auto& rk : d.ranking) {
     std::string params;
     for (const auto& p : rk.params) {
       params += p.is_text() ? fmt::format("{}={} ", p.name, p.text)
                             : fmt::format("{}={:.3g} ", p.name, p.value);
     }
-    out += fmt::format("| {} | {:.3f} | {:.1f} | {} | {} |\n", rk.effect, rk.score,
-                       rk.significance, rk.plausible ? "yes" : "no", params);
+    out += fmt::format("| {} | {:.3f} | {:.1f} | {} | {} |\n", rk.effect, rk.score, rk.significance,
+                       rk.plausible ? "yes" : "no", params);
   }
-  out += "\nscore: share of the calibrated nominal model's held-out squared error that the "
-         "extension removes; significance: paired t statistic over held-out segments.\n\n";
+  out +=
+      "\nscore: share of the calibrated nominal model's held-out squared error that the "
+      "extension removes; significance: paired t statistic over held-out segments.\n\n";
   if (plots) {
-    out += "## Where it shows\n\n"
-           "![residual time series](residuals_time.png)\n\n"
-           "Residuals (simulation minus measurement) of the nominal and extended model.\n\n"
-           "![residuals against physical regressors](residuals_regressors.png)\n\n"
-           "Nominal-model residuals against load pressure p1-p2, velocity, dp/dt, du/dt, "
-           "command size and p1+p2: a leak follows load pressure, friction jumps with velocity "
-           "sign, spool lag follows du/dt, overlap shows for small commands.\n\n"
-           "![residual spectra](residuals_spectrum.png)\n\n"
-           "Residual spectra: a supply ripple is a line.\n";
+    out +=
+        "## Where it shows\n\n"
+        "![residual time series](residuals_time.png)\n\n"
+        "Residuals (simulation minus measurement) of the nominal and extended model.\n\n"
+        "![residuals against physical regressors](residuals_regressors.png)\n\n"
+        "Nominal-model residuals against load pressure p1-p2, velocity, dp/dt, du/dt, "
+        "command size and p1+p2: a leak follows load pressure, friction jumps with velocity "
+        "sign, spool lag follows du/dt, overlap shows for small commands.\n\n"
+        "![residual spectra](residuals_spectrum.png)\n\n"
+        "Residual spectra: a supply ripple is a line.\n";
   } else {
     out += "(The plots could not be drawn: /usr/bin/python3 with matplotlib is needed.)\n";
   }
@@ -111,9 +121,9 @@ bool write_report(const std::string& dir, const MeasuredRecord& record, const Di
   const std::filesystem::path base(dir);
   write_file(base / "residuals.csv", residual_csv(record, d));
   write_file(base / "result.json", diagnosis_json(d));
-  const std::string command = fmt::format("/usr/bin/python3 '{}' '{}' > '{}' 2>&1",
-                                          LEAKMON_MODEL_PLOT_SCRIPT, dir,
-                                          (base / "plots.log").string());
+  const std::string command =
+      fmt::format("/usr/bin/python3 '{}' '{}' > '{}' 2>&1", LEAKMON_MODEL_PLOT_SCRIPT, dir,
+                  (base / "plots.log").string());
   const bool plots = std::system(command.c_str()) == 0;
   write_file(base / "report.md", markdown(record, d, plots));
   return plots;

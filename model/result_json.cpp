@@ -47,9 +47,9 @@ std::string diagnosis_json(const Diagnosis& d) {
   const auto& e = d.calibrated_errors;
   out += fmt::format("  \"calibrated\": {{\"beta\": {}, \"Kv\": {}, \"m\": {}, \"b\": {}}},\n",
                      number(c.beta), number(c.Kv), number(c.m), number(c.b));
-  out += fmt::format(
-      "  \"calibrated_errors\": {{\"beta\": {}, \"Kv\": {}, \"m\": {}, \"b\": {}}},\n",
-      number(e.beta), number(e.Kv), number(e.m), number(e.b));
+  out +=
+      fmt::format("  \"calibrated_errors\": {{\"beta\": {}, \"Kv\": {}, \"m\": {}, \"b\": {}}},\n",
+                  number(e.beta), number(e.Kv), number(e.m), number(e.b));
   out += "  \"ranking\": [\n";
   for (std::size_t i = 0; i < d.ranking.size(); ++i) {
     const auto& r = d.ranking[i];

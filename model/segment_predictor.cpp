@@ -126,8 +126,8 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
   }
 }
 
-void SegmentPredictor::predict(const ModelParameters& parameters,
-                               std::span<const Segment> segments, Prediction& out) const {
+void SegmentPredictor::predict(const ModelParameters& parameters, std::span<const Segment> segments,
+                               Prediction& out) const {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.x.assign(record_.size(), nan);
   out.p1.assign(record_.size(), nan);

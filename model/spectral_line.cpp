@@ -77,8 +77,8 @@ std::optional<SpectralLine> find_spectral_line(const MeasuredRecord& record,
     if (power[k] < power[k - 1] || power[k] < power[k + 1]) continue;  // local maxima only
     around.assign(power.begin() + static_cast<std::ptrdiff_t>(k - std::min(k, half)),
                   power.begin() + static_cast<std::ptrdiff_t>(std::min(power.size(), k + half)));
-    std::nth_element(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2),
-                     around.end());
+    std::nth_element(around.begin(),
+                     around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2), around.end());
     const double median = std::max(around[around.size() / 2], 1e-300);
     const double prominence = power[k] / median;
     if (!best || prominence > best->prominence) {

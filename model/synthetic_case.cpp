@@ -59,7 +59,9 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
     c.main_value = value;
     return value;
   };
-  const auto channel = [&] { return draw.coin() ? sim::PressureChannel::p1 : sim::PressureChannel::p2; };
+  const auto channel = [&] {
+    return draw.coin() ? sim::PressureChannel::p1 : sim::PressureChannel::p2;
+  };
   if (c.effect == "internal_leakage") {
     e.internal_leakage = sim::InternalLeakage{set_main("C_L", draw.log_uniform(5e-13, 5e-12))};
   } else if (c.effect == "external_leakage") {

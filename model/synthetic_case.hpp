@@ -14,9 +14,9 @@ namespace leakmon::model {
 
 struct SyntheticCase {
   std::uint64_t seed = 0;
-  std::string effect = "none";   // MODEL.md name or "none"
-  std::string main_parameter;    // e.g. "C_L"; empty for none
-  double main_value = 0.0;       // the true value of that parameter [SI]
+  std::string effect = "none";  // MODEL.md name or "none"
+  std::string main_parameter;   // e.g. "C_L"; empty for none
+  double main_value = 0.0;      // the true value of that parameter [SI]
   sim::Scenario scenario;
 };
 

@@ -32,8 +32,8 @@ int run_check(int argc, char** argv) {
                  "Calibrates beta, Kv, m, b on the fitting part of a capture, extends the model\n"
                  "with each effect of MODEL.md's library, scores each on held-out data and names\n"
                  "the best when its gain is significant (else `none`). Writes FORMATS.md's JSON.");
-  args.option("data", "CAPTURE.csv", "capture with at least t,u,x,p1,p2 at 500 Hz",
-              std::nullopt, true)
+  args.option("data", "CAPTURE.csv", "capture with at least t,u,x,p1,p2 at 500 Hz", std::nullopt,
+              true)
       .option("json", "RESULT.json", "where to write the result", std::nullopt, true)
       .option("report", "DIR", "also write a Markdown report with plots into DIR", "");
   if (!args.parse(argc, argv, 2)) return 0;
@@ -75,10 +75,11 @@ int run_evaluate_cases(int argc, char** argv) {
     const auto seed = first + static_cast<std::uint64_t>(i);
     summary.cases.push_back(model::evaluate_case(seed, effect, case_settings));
     const auto& c = summary.cases.back();
-    fmt::print("case {} seed {}: {} -> {} ({} true {:.4g} est {:.4g}) nrmse {:.4f} -> {:.4f} "
-               "{:.1f} s\n",
-               i, seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate,
-               c.nrmse_before, c.nrmse_after, c.seconds);
+    fmt::print(
+        "case {} seed {}: {} -> {} ({} true {:.4g} est {:.4g}) nrmse {:.4f} -> {:.4f} "
+        "{:.1f} s\n",
+        i, seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
+        c.nrmse_after, c.seconds);
     std::fflush(stdout);
   }
   const std::string dir = args.get("out");

@@ -278,7 +278,7 @@ int run_realdata(int argc, char** argv) {
   auto json = fmt::output_file((out / "realdata.json").string());
   std::string md;
   json.print("{{\"baseline_quantile\": {}, \"pairs\": [\n", q);
-  md.print(
+  md += fmt::format(
       "| pair | feature | median faulty | median healthy | AUC (faulty > healthy) |\n"
       "|---|---|---|---|---|\n");
   std::string rule_rows;
@@ -315,7 +315,7 @@ int run_realdata(int argc, char** argv) {
                              100.0 * flagged, 100.0 * fraction_below(healthy_index, baseline));
   }
   json.print("]}}\n");
-  md.print(
+  md += fmt::format(
       "\nThe paper's rule (stroke index below the {:.0f} % quantile of the healthy pair):\n\n"
       "| pair | baseline [counts] | faulty strokes flagged | healthy strokes flagged |\n"
       "|---|---|---|---|\n{}",

@@ -52,8 +52,8 @@ TEST(ModelCli, ChecksACaptureAndWritesJsonAndReport) {
   EXPECT_EQ(std::system(check.c_str()), 0) << read_file(dir + "/result.json");
   const std::string report = read_file(dir + "/report/report.md");
   EXPECT_NE(report.find("internal_leakage"), std::string::npos);
-  for (const char* png : {"residuals_time.png", "residuals_regressors.png",
-                          "residuals_spectrum.png"}) {
+  for (const char* png :
+       {"residuals_time.png", "residuals_regressors.png", "residuals_spectrum.png"}) {
     EXPECT_GT(std::filesystem::file_size(dir + "/report/" + png), 10000u) << png;
   }
 }
@@ -64,9 +64,9 @@ TEST(ModelCli, RefusesACaptureWithoutPressures) {
     std::ofstream out(dir + "/capture.csv");
     out << "t,u,x\n0,0,0\n0.002,0,0\n";
   }
-  EXPECT_NE(run("model check --data " + dir + "/capture.csv --json " + dir + "/r.json",
-                dir + "/log.txt"),
-            0);
+  EXPECT_NE(
+      run("model check --data " + dir + "/capture.csv --json " + dir + "/r.json", dir + "/log.txt"),
+      0);
   const std::string log = read_file(dir + "/log.txt");
   EXPECT_NE(log.find(dir + "/capture.csv"), std::string::npos) << log;
   EXPECT_NE(log.find("'p1', 'p2'"), std::string::npos) << log;

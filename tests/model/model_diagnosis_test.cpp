@@ -38,8 +38,8 @@ TEST_P(HiddenEffect, IsNamedWithItsMainParameter) {
 INSTANTIATE_TEST_SUITE_P(ModelCheck, HiddenEffect,
                          testing::Values("none", "internal_leakage", "external_leakage",
                                          "coulomb_friction", "entrained_air", "valve_overlap",
-                                         "valve_bias", "spool_lag", "supply_ripple",
-                                         "supply_droop", "sensor_offset", "sensor_lag"));
+                                         "valve_bias", "spool_lag", "supply_ripple", "supply_droop",
+                                         "sensor_offset", "sensor_lag"));
 
 }  // namespace
 }  // namespace leakmon::model

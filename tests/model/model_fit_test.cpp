@@ -7,6 +7,7 @@
 
 #include "model/actuator_model.hpp"
 #include "model/calibration_fit.hpp"
+#include "model/diagnosis.hpp"
 #include "model/measured_record.hpp"
 #include "model/synthetic_case.hpp"
 #include "sim/plant.hpp"
@@ -112,6 +113,27 @@ TEST(Calibration, RecoversPerturbedParametersFromNoisyData) {
   // The calibrated nominal model predicts the held-out part to within the noise.
   const auto held_out = spread(split_record(record).held_out, 16);
   EXPECT_LT(predictor.nrmse(fit.parameters, held_out), 0.02);
+}
+
+// The whole workflow on a short capture with a clear leak, cheap enough for the sanitizer
+// builds (the full-size random cases are model_diagnosis_test, labelled long).
+TEST(Diagnosis, NamesAClearLeakOnAShortCapture) {
+  const auto seed = test::model_test_seed("Diagnosis.NamesAClearLeakOnAShortCapture");
+  SyntheticCase c = draw_case(seed, "internal_leakage", {24.0});
+  c.scenario.effects.internal_leakage->C_L = 3e-12;
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  DiagnosisSettings settings;
+  settings.max_fitting_segments = 8;
+  settings.screening_segments = 4;
+  settings.max_held_out_segments = 16;
+  settings.refined_effects = 2;
+  const Diagnosis d = diagnose(record, settings);
+  EXPECT_EQ(d.cause, "internal_leakage");
+  ASSERT_FALSE(d.params.empty());
+  EXPECT_EQ(d.params[0].name, "C_L");
+  EXPECT_NEAR(d.params[0].value, 3e-12, 0.25 * 3e-12);
+  EXPECT_LT(d.nrmse_after, 0.5 * d.nrmse_before);
+  EXPECT_EQ(d.ranking.size(), 11u);
 }
 
 }  // namespace
