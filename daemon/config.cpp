@@ -189,7 +189,7 @@ static std::string resolve_path(const config::ConfigNode& node, const std::strin
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
   root.expect_keys(
-      {"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs"});
+      {"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs", "worker"});
   DaemonConfig config;
   config.source = root.source();
 
@@ -243,6 +243,11 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     metrics->expect_keys({"address", "port"});
     config.metrics.address = metrics->get_string("address", config.metrics.address);
     config.metrics.port = static_cast<int>(metrics->get_int("port", config.metrics.port, 0, 65535));
+  }
+  if (auto worker = root.find("worker")) {
+    worker->expect_keys({"priority", "poll_us"});
+    config.worker_priority = static_cast<int>(worker->get_int("priority", 70, 0, 99));
+    config.worker_poll_ns = worker->get_int("poll_us", 500, 50, 100000) * 1000;
   }
   if (auto outputs = root.find("outputs")) {
     std::set<std::string> output_names;

@@ -50,6 +50,7 @@ std::string acquisition_signature(const DaemonConfig& config) {
                       config.recording.rotate_seconds, config.recording.keep_files,
                       config.recording.flush_seconds);
   text += fmt::format("metrics {}:{}\n", config.metrics.address, config.metrics.port);
+  text += fmt::format("worker {} {}\n", config.worker_priority, config.worker_poll_ns);
   return text;
 }
 
@@ -149,8 +150,12 @@ void Daemon::start() {
   sinks_ = build_sinks(config_);
   worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
 
-  worker_thread_ = std::thread([this] {
+  std::vector<std::string> worker_warnings;
+  std::atomic<bool> worker_ready{false};
+  worker_thread_ = std::thread([this, &worker_warnings, &worker_ready] {
     const std::int64_t poll_ns = config_.worker_poll_ns;
+    worker_warnings = make_thread_realtime(config_.worker_priority, {}).warnings;
+    worker_ready.store(true, std::memory_order_release);
     while (!stop_worker_.load(std::memory_order_acquire)) {
       if (worker_->drain(monotonic_now_ns()) == 0) {
         std::this_thread::sleep_for(std::chrono::nanoseconds(poll_ns));
@@ -166,6 +171,10 @@ void Daemon::start() {
     });
   }
   // Start-up warnings are logged here, by the main thread, never by the loops.
+  while (!worker_ready.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  for (const auto& warning : worker_warnings) spdlog::warn("worker: {}", warning);
   for (auto& group : groups_) {
     while (!group->realtime_ready.load(std::memory_order_acquire)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -281,10 +290,11 @@ void Daemon::reload() {
   try {
     DaemonConfig next = check_config(config_path_);
     if (acquisition_signature(next) != acquisition_signature(config_)) {
-      throw config::ConfigError(fmt::format(
-          "{}: drivers, sampling groups, recording or metrics changed; these need a restart "
-          "(systemctl restart leakmon)",
-          config_path_));
+      throw config::ConfigError(
+          fmt::format("{}: drivers, sampling groups, recording, metrics or worker changed; these "
+                      "need a restart "
+                      "(systemctl restart leakmon)",
+                      config_path_));
     }
     auto sinks = build_sinks(next);
     worker_->apply(next, raw(sinks));

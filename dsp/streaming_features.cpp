@@ -98,7 +98,15 @@ void decimate_rows(const double* newest, std::size_t count, std::size_t channels
     for (; k + kOutputs <= count; k += kOutputs) {
       decimate_output_block<kOutputs>(newest + 2 * k, filter, out + k);
     }
-    for (; k < count; ++k) decimate_output_block<1>(newest + 2 * k, filter, out + k);
+    if (k + 4 <= count) {
+      decimate_output_block<4>(newest + 2 * k, filter, out + k);
+      k += 4;
+    }
+    if (k + 2 <= count) {
+      decimate_output_block<2>(newest + 2 * k, filter, out + k);
+      k += 2;
+    }
+    if (k < count) decimate_output_block<1>(newest + 2 * k, filter, out + k);
     return;
   }
   constexpr std::size_t kBlock = 8;

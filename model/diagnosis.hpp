@@ -42,7 +42,7 @@ struct DiagnosisSettings {
   // Naming a cause needs both: the extension removes at least this share of the calibrated
   // nominal model's held-out squared error, and it does so consistently over the held-out
   // segments (paired t statistic). docs/model-check.md explains the values.
-  double min_score = 0.05;
+  double min_score = 0.02;
   double min_significance = 2.5;
 };
 

@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   });
   std::atomic<bool> stop_worker{false};
   std::thread consumer([&] {
+    daemon::make_thread_realtime(config.worker_priority, {});
     while (!stop_worker.load()) {
       if (worker.drain(daemon::monotonic_now_ns()) == 0) {
         std::this_thread::sleep_for(std::chrono::nanoseconds(config.worker_poll_ns));

@@ -23,9 +23,6 @@
 
 namespace leakmon::io::can {
 
-// Keys of a driver mapping that read_signals() consumes, for expect_keys().
-inline constexpr const char* kSignalDriverKeys[] = {"signals", "max_age"};
-
 // Default max age when neither the driver nor the signal sets one: ten 500 Hz periods. A value
 // held for longer would flatten the pressure trace, and a flat trace has a low wavelet index,
 // which is exactly what a leak looks like: a silent sensor must become a gap, not an alarm.
