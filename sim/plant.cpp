@@ -16,14 +16,44 @@ namespace {
 
 enum Index { kXs, kX, kV, kP1, kP2, kP1Transducer, kP2Transducer, kMassIn1, kMassIn2, kLeaked };
 
+// RK4's stability limit on the negative real axis is h |lambda| = 2.78; staying at 2 keeps
+// the numerical damping of fast modes small.
+constexpr double kStabilityLimit = 2.0;
+// The accuracy-chosen default: 8 steps per 2 ms sample (250 us, the flow-noise grid). Halving
+// it changes nominal trajectories by tens of pascals, two orders below the 5 kPa pressure LSB
+// (tests/sim/numerics_test.cpp checks this on every preset).
+constexpr int kDefaultStepsPerSample = 8;
+
 }  // namespace
+
+double automatic_integration_step(const Parameters& params, const Effects& effects,
+                                  double sample_rate_hz) {
+  const double period = 1.0 / sample_rate_hz;
+  double h = period / kDefaultStepsPerSample;
+  // Fastest real eigenvalues of the plant: the dampers over the mass, Coulomb friction's tanh
+  // slope over the mass, the spool, a lagging transducer, and a chamber at its smallest
+  // volume (piston at a stop) fed through a fully open laminar orifice; the end-stop spring's
+  // frequency.
+  double fastest = (params.b + params.c_stop) / params.m;
+  if (effects.coulomb_friction) {
+    fastest += effects.coulomb_friction->F_C / (kCoulombVelocityScale * params.m);
+  }
+  const double tau = effects.spool_lag ? effects.spool_lag->tau : params.tau;
+  const double hydraulic = params.beta * (params.Kv / std::sqrt(params.dp_lin) + 2.0 * params.C_n) /
+                           (params.V_dead + params.V_line);
+  fastest = std::max({fastest, 1.0 / tau, hydraulic, std::sqrt(params.K_stop / params.m)});
+  if (effects.sensor_lag) fastest = std::max(fastest, 1.0 / effects.sensor_lag->tau_s);
+  h = std::min(h, kStabilityLimit / fastest);
+  return period / std::ceil(period / h - 1e-9);
+}
 
 Plant::Plant(const Parameters& params, const Effects& effects, std::uint64_t noise_seed,
              double integration_step_s)
     : params_(params),
       effects_(effects),
       noise_(params.sigma_w, params.tau_w, kNoiseGridStep, noise_seed),
-      step_(integration_step_s) {
+      step_(integration_step_s > 0.0 ? integration_step_s
+                                     : automatic_integration_step(params, effects, 500.0)) {
   c_ = {};
   c_.A = params.A();
   c_.V0 = params.V0();

@@ -3,9 +3,8 @@
 // open-loop (the model check drives it with a measured u) or inside Rig.
 //
 // The spool flow noise is an Ornstein-Uhlenbeck process drawn by its exact discretisation on a
-// fixed grid (kNoiseGridStep = 0.25 ms) and interpolated
-// linearly, so the noise input does not depend on the integration step and trajectories
-// converge as the step shrinks.
+// fixed grid (kNoiseGridStep = 0.25 ms) and interpolated linearly, so the noise input does not
+// depend on the integration step and trajectories converge as the step shrinks.
 #pragma once
 
 #include <Eigen/Core>
@@ -48,11 +47,18 @@ struct PlantFlows {
   double C_L;             // internal leakage coefficient in force now
 };
 
+// The RK4 step used when a scenario leaves it at 0: chosen by accuracy (the step-halving test
+// in tests/sim judges it) and shortened where an effect makes the plant stiffer (Coulomb
+// friction's tanh, light masses); always an integer fraction of the sample period.
+double automatic_integration_step(const Parameters& params, const Effects& effects,
+                                  double sample_rate_hz);
+
 class Plant {
  public:
-  // Allocates nothing after construction.
+  // Allocates nothing after construction. integration_step_s = 0 chooses
+  // automatic_integration_step() for 500 Hz samples.
   Plant(const Parameters& params, const Effects& effects, std::uint64_t noise_seed,
-        double integration_step_s = 1e-4);
+        double integration_step_s = 0.0);
 
   // Rest state of MODEL.md's simulation conventions: x = v = xs = 0, p1 = p2 = (ps + pt)/2,
   // noise restarted from its seed, time 0.

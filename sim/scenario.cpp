@@ -7,21 +7,12 @@
 #include <stdexcept>
 
 #include "config/yaml_reader.hpp"
-#include "sim/friction.hpp"
 
 namespace leakmon::sim {
 namespace {
 
 // MODEL.md's effect table converts leak sizes quoted in l/min/MPa: 1 l/min = 1/60000 m^3/s.
 constexpr double kLitresPerMinutePerMPa = 1.0 / 60000.0 / 1e6;
-
-// RK4's stability limit on the negative real axis is h |lambda| = 2.78; staying at 2 keeps
-// the numerical damping of fast modes small.
-constexpr double kStabilityLimit = 2.0;
-// The accuracy-chosen default: 8 steps per 2 ms sample (250 us, the flow-noise grid). Halving
-// it changes nominal trajectories by tens of pascals, two orders below the 5 kPa pressure LSB
-// (tests/sim/numerics_test.cpp checks this on every preset).
-constexpr int kDefaultStepsPerSample = 8;
 
 struct NumberSpec {
   std::string_view name;
@@ -207,27 +198,6 @@ Scenario paper_experiment(std::string_view name, ControllerKind controller, doub
 
 std::uint64_t Scenario::samples() const {
   return static_cast<std::uint64_t>(std::llround(duration_s * sample_rate_hz));
-}
-
-double automatic_integration_step(const Parameters& params, const Effects& effects,
-                                  double sample_rate_hz) {
-  const double period = 1.0 / sample_rate_hz;
-  double h = period / kDefaultStepsPerSample;
-  // Fastest real eigenvalues of the plant: the dampers over the mass, Coulomb friction's tanh
-  // slope over the mass, the spool, a lagging transducer, and a chamber at its smallest
-  // volume (piston at a stop) fed through a fully open laminar orifice; the end-stop spring's
-  // frequency.
-  double fastest = (params.b + params.c_stop) / params.m;
-  if (effects.coulomb_friction) {
-    fastest += effects.coulomb_friction->F_C / (kCoulombVelocityScale * params.m);
-  }
-  const double tau = effects.spool_lag ? effects.spool_lag->tau : params.tau;
-  const double hydraulic = params.beta * (params.Kv / std::sqrt(params.dp_lin) + 2.0 * params.C_n) /
-                           (params.V_dead + params.V_line);
-  fastest = std::max({fastest, 1.0 / tau, hydraulic, std::sqrt(params.K_stop / params.m)});
-  if (effects.sensor_lag) fastest = std::max(fastest, 1.0 / effects.sensor_lag->tau_s);
-  h = std::min(h, kStabilityLimit / fastest);
-  return period / std::ceil(period / h - 1e-9);
 }
 
 double integration_step(const Scenario& scenario) {

@@ -11,6 +11,7 @@
 #include "sim/controller.hpp"
 #include "sim/effects.hpp"
 #include "sim/parameters.hpp"
+#include "sim/plant.hpp"
 #include "sim/reference.hpp"
 #include "sim/sensors.hpp"
 
@@ -33,11 +34,6 @@ struct Scenario {
   std::uint64_t samples() const;  // rows of the capture: duration * rate, rounded
 };
 
-// The RK4 step used when a scenario leaves it at 0: chosen by accuracy (the step-halving test
-// in tests/sim judges it) and shortened where an effect makes the plant stiffer (Coulomb
-// friction's tanh, light masses); always an integer fraction of the sample period.
-double automatic_integration_step(const Parameters& params, const Effects& effects,
-                                  double sample_rate_hz);
 double integration_step(const Scenario& scenario);  // explicit value or the automatic one
 
 // Throws config::ConfigError ("file:line:column: path: message") on any bad input.

@@ -54,6 +54,7 @@ std::vector<Candidate> candidates() {
       {"index_cusum_p1", "index_cusum", false, false, false, cusum_grid, 1.0, 0.0, 0.5},
       {"index_cusum", "index_cusum", true, false, false, cusum_grid, 1.0, 0.0, 0.5},
       {"flow_balance", "flow_balance", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
+      {"fused", "fused", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
       {"default", "default", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
   };
 }

@@ -55,10 +55,12 @@ def main():
     for d in detectors:
         pts = sorted((r["leak"], r["detection_rate"], r["median_delay"])
                      for r in rows(d) if r["design"] and r["leak"])
+        fa = [r["false_alarms_per_hour"] for r in rows(d) if r["design"] and r["leak"] == 0]
+        label = "%s (%.2f false alarms/h)" % (d["name"], fa[0]) if fa else d["name"]
         x = [p[0] * LPM_PER_MPA for p in pts]
-        ax1.plot(x, [p[1] for p in pts], marker="o", label=d["name"])
+        ax1.plot(x, [p[1] for p in pts], marker="o", label=label)
         ax2.plot(x, [p[2] if p[2] is not None else float("nan") for p in pts], marker="o",
-                 label=d["name"])
+                 label=label)
     for ax in (ax1, ax2):
         ax.set_xscale("log")
         ax.set_xlabel("C_L [l/min/MPa]")

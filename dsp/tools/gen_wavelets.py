@@ -32,6 +32,7 @@ def main():
         f"{pywt.__version__}; do not edit.\n",
         "// Filter banks exactly as pywt.Wavelet(name).dec_lo/dec_hi/rec_lo/rec_hi.\n",
         '#include "dsp/wavelet_tables.hpp"\n\n',
+        "// clang-format off\n",
         "namespace leakmon::dsp::tables {\nnamespace {\n\n",
     ]
     rows = []
@@ -48,6 +49,7 @@ def main():
     parts.append("  static constexpr FilterBank kBanks[] = {\n")
     parts.extend(rows)
     parts.append("  };\n  return kBanks;\n}\n\n}  // namespace leakmon::dsp::tables\n")
+    parts.append("// clang-format on\n")
     out.write_text("".join(parts))
     print(f"wrote {out} ({len(FAMILIES)} wavelets)")
 

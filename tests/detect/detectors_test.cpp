@@ -39,10 +39,10 @@ RunResult run(Detector& detector, test::SyntheticRig& rig, double seconds) {
 }
 
 TEST(DetectorFactory, DefaultDependsOnAcquiredChannels) {
-  EXPECT_EQ(default_detector_kind(kAll), "fused");
+  EXPECT_EQ(default_detector_kind(kAll), "flow_balance");
   EXPECT_EQ(default_detector_kind(kPressuresOnly), "index_cusum");
   EXPECT_EQ(default_detector_kind(AvailableSignals{true, false, false, false}), "index_cusum");
-  EXPECT_EQ(make_detector("default", kAll, 0.04, nullptr)->name(), "fused");
+  EXPECT_EQ(make_detector("default", kAll, 0.04, nullptr)->name(), "flow_balance");
   EXPECT_EQ(make_detector("default", kPressuresOnly, 0.04, nullptr)->name(), "index_cusum");
   for (const auto& kind : detector_kinds()) {
     EXPECT_NE(make_detector(kind, kAll, 0.04, nullptr), nullptr) << kind;
@@ -75,7 +75,7 @@ TEST(DetectorFactory, OptionErrorsNameFileLineAndKey) {
   }
   const auto good = config::ConfigNode::load_string(
       "learn_seconds: 30\ndesign_leak: 2.0e-12\nrest_speed: 0.003\n", "good.yaml");
-  EXPECT_EQ(make_detector("default", kAll, 0.04, &good)->name(), "fused");
+  EXPECT_EQ(make_detector("default", kAll, 0.04, &good)->name(), "flow_balance");
 }
 
 TEST(PaperBaselineDetector, LearnsBaselineAndFlagsALargeDrop) {

@@ -2,12 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <numeric>
+#include <sstream>
 #include <string>
 
 #include "dsp/dwt.hpp"
 #include "dsp/wavelet.hpp"
 #include "tests/dsp/pywt_oracle.hpp"
+#include "tests/support/paths.hpp"
 
 namespace leakmon::dsp {
 namespace {
@@ -93,6 +97,25 @@ TEST(Wavelet, MaxLevelEqualsPyWavelets) {
           << name << " n=" << n;
     }
   }
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(Wavelet, CheckedInTablesAreWhatTheGeneratorWrites) {
+  const std::string dir = test::scratch_dir("wavelet_generator");
+  const std::string command = test::python() + " " + test::source_dir() +
+                              "/dsp/tools/gen_wavelets.py " + dir + "/wavelet_tables.cpp > " + dir +
+                              "/log.txt";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const std::string regenerated = file_text(dir + "/wavelet_tables.cpp");
+  EXPECT_GT(regenerated.size(), 10000u);
+  EXPECT_TRUE(regenerated == file_text(test::source_dir() + "/dsp/wavelet_tables.cpp"))
+      << "dsp/wavelet_tables.cpp is not what dsp/tools/gen_wavelets.py writes: regenerate it";
 }
 
 }  // namespace

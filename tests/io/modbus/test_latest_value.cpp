@@ -2,6 +2,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <thread>
 
@@ -55,6 +56,11 @@ TEST(LatestValues, ReaderNeverSeesATornSnapshotUnderContention) {
       values.set(1, 2.0 * static_cast<double>(i), i);
       values.end_write();
       writer_started.store(true, std::memory_order_release);
+      // The poller writes once per response, not back to back: leave the reader a window
+      // (busy, so that the writer stays on its core and the two keep racing).
+      const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(2);
+      while (std::chrono::steady_clock::now() < until) {
+      }
     }
   });
   while (!writer_started.load(std::memory_order_acquire)) std::this_thread::yield();

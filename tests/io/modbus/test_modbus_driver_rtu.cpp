@@ -31,7 +31,8 @@ TEST(ModbusRtu, SamplesEqualTheServedCaptureOverAPseudoTerminal) {
   ServedCapture::Tally warmup;
   ASSERT_TRUE(capture.run_until_fresh(*driver, 10, 20.0, warmup)) << driver->health().last_error;
   const auto tally = capture.run(*driver, 1.0);
-  EXPECT_EQ(warmup.mismatches + tally.mismatches, 0U);
+  EXPECT_EQ(warmup.mismatches + tally.mismatches, 0U)
+      << warmup.first_mismatch << tally.first_mismatch;
   EXPECT_EQ(tally.allocations, 0U);
   EXPECT_GT(tally.fresh, 0U);
   EXPECT_EQ(driver->health().state, "ok");
