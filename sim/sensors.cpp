@@ -42,7 +42,9 @@ Measurement Sensors::measure(double x, double p1_transducer, double p2_transduce
   if (settings_.enabled) {
     m.x += settings_.position_noise_sigma * noise;
     if (settings_.position_quantisation) {
-      m.x = std::nearbyint(m.x / settings_.position_resolution) * settings_.position_resolution;
+      // + 0.0 turns a rounded -0 into 0, so captures do not print "-0".
+      m.x =
+          std::nearbyint(m.x / settings_.position_resolution) * settings_.position_resolution + 0.0;
     }
   }
   return m;
