@@ -28,10 +28,14 @@ std::vector<double> segment_errors(const SegmentPredictor& predictor,
   return out;
 }
 
-double total(const std::vector<double>& v) {
+// Mean over held-out segments of log(error before / error after): a geometric mean, so one
+// segment where an extension diverges cannot outweigh all the others (nor one lucky segment).
+double mean_log_ratio(const std::vector<double>& before, const std::vector<double>& after) {
   double sum = 0.0;
-  for (double x : v) sum += x;
-  return sum;
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    sum += std::log(std::max(before[i], 1e-300) / std::max(after[i], 1e-300));
+  }
+  return sum / static_cast<double>(std::max<std::size_t>(before.size(), 1));
 }
 
 // Paired t statistic of the per-segment log error ratio: each held-out segment is one
@@ -106,7 +110,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     RankedEffect r;
     r.effect = candidate.effect;
     const auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
-    r.score = 1.0 - total(errors) / total(nominal_errors);
+    r.score = 1.0 - std::exp(-mean_log_ratio(nominal_errors, errors));
     r.significance = paired_t(nominal_errors, errors);
     r.plausible = candidate.plausible(fit.values);
     r.params = named_values(candidate, fit);
