@@ -75,23 +75,21 @@ inline void decimate_rows(const double* newest, std::size_t count, std::size_t c
   for (; c < channels; ++c) decimate_channel_block<1>(newest, count, channels, filter, out, c);
 }
 
-// sums[c] += sum_i weights[i] * (rows[i * channels + c] - reference[c]): one weighted sum per
-// channel over `length` interleaved rows (the boundary map's rows). Weighing the deviation from
-// a reference level keeps the rounding relative to the signal's variation, not its level.
-inline void add_weighted_rows(const double* weights, std::size_t length, const double* rows,
-                              std::size_t channels, const double* reference, double* sums) {
-  if (channels == 1) {
-    // Four partial sums, for the same reason as in add_squares.
-    const double ref = reference[0];
-    double lane[4] = {0.0, 0.0, 0.0, 0.0};
-    std::size_t i = 0;
-    for (; i + 4 <= length; i += 4) {
-      for (std::size_t j = 0; j < 4; ++j) lane[j] += weights[i + j] * (rows[i + j] - ref);
-    }
-    for (; i < length; ++i) lane[i % 4] += weights[i] * (rows[i] - ref);
-    sums[0] += (lane[0] + lane[1]) + (lane[2] + lane[3]);
-    return;
+// sum_i weights[i] * values[i] for `length` a multiple of 8, as eight partial sums (four SSE2
+// registers, so that no addition waits on the previous one).
+inline double dot_multiple_of_8(const double* weights, const double* values, std::size_t length) {
+  double lane[8] = {};
+  for (std::size_t i = 0; i < length; i += 8) {
+#pragma GCC unroll 8
+    for (std::size_t j = 0; j < 8; ++j) lane[j] += weights[i + j] * values[i + j];
   }
+  return ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
+}
+
+// sums[c] += sum_i weights[i] * rows[i * channels + c]: one weighted sum per channel over
+// `length` interleaved rows (the boundary map's rows), eight channels at a time.
+inline void add_weighted_rows(const double* weights, std::size_t length, const double* rows,
+                              std::size_t channels, double* sums) {
   constexpr std::size_t kBlock = 8;
   std::size_t c = 0;
   for (; c + kBlock <= channels; c += kBlock) {
@@ -101,14 +99,12 @@ inline void add_weighted_rows(const double* weights, std::size_t length, const d
       const double weight = weights[i];
       const double* __restrict__ row = rows + i * channels + c;
 #pragma GCC unroll 8
-      for (std::size_t b = 0; b < kBlock; ++b) sum[b] += weight * (row[b] - reference[c + b]);
+      for (std::size_t b = 0; b < kBlock; ++b) sum[b] += weight * row[b];
     }
     for (std::size_t b = 0; b < kBlock; ++b) sums[c + b] = sum[b];
   }
   for (; c < channels; ++c) {
-    for (std::size_t i = 0; i < length; ++i) {
-      sums[c] += weights[i] * (rows[i * channels + c] - reference[c]);
-    }
+    for (std::size_t i = 0; i < length; ++i) sums[c] += weights[i] * rows[i * channels + c];
   }
 }
 

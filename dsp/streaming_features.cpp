@@ -129,7 +129,7 @@ struct StreamingFeatures::Engine {
       }
       const LevelPlan& top = levels.back();
       boundary = BoundaryMap(params.window, w, params.mode, params.level, top.clean_lo,
-                             top.clean_hi);
+                             top.clean_hi, channels);
       boundary_out.resize((boundary.left_count() + boundary.right_count()) * channels);
     } else {
       transform.emplace(params.window, w, params.mode, params.level);
@@ -141,24 +141,25 @@ struct StreamingFeatures::Engine {
   void reset() noexcept {
     seen = 0;
     next_start = 0;
+    gaps_checked = 0;
     samples.restart(0);
     for (auto& h : coeffs) h.restart(0);
     std::fill(gap_end.begin(), gap_end.end(), 0);
     std::fill(latest.begin(), latest.end(), DetailFeature{});
   }
 
+  // Per sample only a copy into the history; NaN checks and all arithmetic run once per window,
+  // over the samples that arrived since the previous one.
   bool push(std::span<const double> sample) noexcept {
     assert(sample.size() == channels);
     const std::uint64_t t = seen++;
-    for (std::size_t c = 0; c < channels; ++c) {
-      if (std::isnan(sample[c])) gap_end[c] = t + 1;
-    }
     if (t < next_start) return false;  // step > window: this sample is in no window
     if (samples.end() != t) samples.restart(t);
     double* row = samples.append();
-    for (std::size_t c = 0; c < channels; ++c) row[c] = sample[c];
+    for (std::size_t c = 0; c < channels; ++c) row[c] = sample[c];  // no memmove call for a few
     if (seen != next_start + params.window) return false;
     const std::uint64_t start = next_start;
+    note_gaps(std::max(gaps_checked, start), seen);
     if (levels.empty()) {
       recompute_window(start);
     } else {
@@ -171,6 +172,17 @@ struct StreamingFeatures::Engine {
     next_start += params.step;
     samples.release_before(next_start);
     return true;
+  }
+
+  // gap_end[c] = one past the last NaN of channel c among samples [first, end) (in the history).
+  void note_gaps(std::uint64_t first, std::uint64_t end) noexcept {
+    const double* rows = samples.row(first);
+    for (std::uint64_t t = first; t < end; ++t, rows += channels) {
+      for (std::size_t c = 0; c < channels; ++c) {
+        if (std::isnan(rows[c])) gap_end[c] = t + 1;
+      }
+    }
+    gaps_checked = end;
   }
 
   std::size_t detail_count() const noexcept {
@@ -207,7 +219,7 @@ struct StreamingFeatures::Engine {
       }
       output.release_before(((start + params.step) >> level) + l.clean_lo);
     }
-    boundary.apply(samples.row(start), channels, boundary_out.data());
+    boundary.apply(samples.row(start), boundary_out.data());
 
     const LevelPlan& top = levels.back();
     const std::uint64_t origin = start >> levels.size();
@@ -224,7 +236,7 @@ struct StreamingFeatures::Engine {
   const Wavelet& w;
   std::vector<LevelPlan> levels;  // empty: recompute every window
   RowHistory samples;
-  std::vector<RowHistory> coeffs;  // per level: its clean coefficients
+  std::vector<RowHistory> coeffs;    // per level: its clean coefficients
   BoundaryMap boundary;              // the top level's boundary coefficients from the samples
   std::vector<double> boundary_out;  // their values for the current window, per channel
   std::optional<DetailTransform> transform;
@@ -232,6 +244,7 @@ struct StreamingFeatures::Engine {
   std::vector<double> energy;
   std::vector<DetailFeature> latest;
   std::vector<std::uint64_t> gap_end;  // per channel: one past its last NaN sample
+  std::uint64_t gaps_checked = 0;      // samples before it have been looked at for NaN
   std::uint64_t seen = 0;
   std::uint64_t next_start = 0;
 };

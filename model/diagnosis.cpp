@@ -92,20 +92,37 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   d.held_out_used = spread(d.plan.held_out, settings.max_held_out_segments);
   const SegmentPredictor predictor(record);
 
-  const FitResult nominal =
-      fit_model(predictor, d.fitting_used, nullptr, Calibration{}, settings.fit);
+  if (auto line = find_spectral_line(record)) d.ripple_line_hz = line->frequency_hz;
+  const auto library = effect_library(d.ripple_line_hz.value_or(0.0));
+
+  // Screening: each candidate fitted together with the calibration on a few segments, from the
+  // catalogue calibration (not from the nominal fit: a large effect distorts the nominal fit,
+  // which then leads the solver into a compensating local minimum).
+  const auto screening_segments = spread(d.fitting_used, settings.screening_segments);
+  FitSettings screening = settings.fit;
+  screening.max_iterations = settings.screening_iterations;
+  std::vector<FitResult> screened;
+  const FitResult* best_screened = nullptr;
+  for (const auto& candidate : library) {
+    screened.push_back(
+        fit_model(predictor, screening_segments, &candidate, Calibration{}, screening));
+  }
+  for (const auto& fit : screened) {
+    if (!best_screened || fit.cost < best_screened->cost) best_screened = &fit;
+  }
+
+  // The calibrated nominal model: the better of two local fits, from the catalogue and from the
+  // best screened calibration (the nominal fit's cost surface has local minima of its own).
+  FitResult nominal = fit_model(predictor, d.fitting_used, nullptr, Calibration{}, settings.fit);
+  if (best_screened) {
+    FitResult other = fit_model(predictor, d.fitting_used, nullptr,
+                                best_screened->parameters.calibration, settings.fit);
+    if (other.cost < nominal.cost) nominal = std::move(other);
+  }
   d.nominal = nominal.parameters;
   const std::vector<double> nominal_errors =
       segment_errors(predictor, nominal.parameters, d.held_out_used);
 
-  if (auto line = find_spectral_line(record)) d.ripple_line_hz = line->frequency_hz;
-  const auto library = effect_library(d.ripple_line_hz.value_or(0.0));
-
-  // Screening: each candidate's own parameters on a few segments, the calibration held at the
-  // nominal fit. Cheap, and enough to see which extensions predict held-out data at all.
-  const auto screening_segments = spread(d.fitting_used, settings.screening_segments);
-  FitSettings screening = settings.fit;
-  screening.max_iterations = settings.screening_iterations;
   const auto score = [&](const EffectCandidate& candidate, FitResult fit) {
     RankedEffect r;
     r.effect = candidate.effect;
@@ -120,12 +137,9 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // Best variant of each effect (e.g. the chamber that leaks), by held-out error.
   std::map<std::string, RankedEffect> best;
   std::map<std::string, EffectCandidate> best_candidate;
-  for (const auto& candidate : library) {
-    screening.free_calibration = {true, true, true, true};
-    // From the catalogue calibration, not the nominal fit: a large effect distorts the
-    // nominal fit, which then leads the solver into a compensating local minimum.
-    RankedEffect r = score(
-        candidate, fit_model(predictor, screening_segments, &candidate, Calibration{}, screening));
+  for (std::size_t i = 0; i < library.size(); ++i) {
+    const auto& candidate = library[i];
+    RankedEffect r = score(candidate, std::move(screened[i]));
     auto it = best.find(candidate.effect);
     if (it == best.end() || r.score > it->second.score) {
       best[candidate.effect] = std::move(r);

@@ -23,7 +23,9 @@ struct NamedValue {
 
 struct RankedEffect {
   std::string effect;
-  double score = 0.0;         // share of the nominal model's held-out squared error it removes
+  // Share of the nominal model's held-out squared error it removes: 1 - the geometric mean
+  // over held-out segments of error after / error before.
+  double score = 0.0;
   double significance = 0.0;  // paired t statistic of the held-out per-segment improvement
   bool plausible = false;     // fitted main parameter is a physical instance of the effect
   bool refined = false;       // fitted with the calibration on all fitting segments

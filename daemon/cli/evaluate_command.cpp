@@ -94,6 +94,7 @@ struct Settings {
   double detect_within = 60.0;
   std::uint64_t seed = 1;
   int jobs = 2;
+  std::vector<std::string> effects;  // MODEL.md effect names on every run (default parameters)
 };
 
 double uniform(std::mt19937_64& rng, double lo, double hi) {
@@ -101,7 +102,8 @@ double uniform(std::mt19937_64& rng, double lo, double hi) {
 }
 
 // A rig drawn across MODEL.md's calibration spread and the load range.
-sim::Scenario draw_rig(std::mt19937_64& rng, int id, std::uint64_t seed, double duration) {
+sim::Scenario draw_rig(std::mt19937_64& rng, int id, std::uint64_t seed, double duration,
+                       const std::vector<std::string>& effects) {
   sim::Scenario s = sim::preset("healthy", seed);
   s.name = fmt::format("evaluate-{}", id);
   s.origin = fmt::format("leakmon evaluate run {}", id);
@@ -115,6 +117,7 @@ sim::Scenario draw_rig(std::mt19937_64& rng, int id, std::uint64_t seed, double 
   const double amplitude = uniform(rng, 0.6, 1.0);  // smaller steps excite the index less
   s.reference.amp_min *= amplitude;
   s.reference.amp_max *= amplitude;
+  for (const auto& effect : effects) s.effects.enable(effect);
   return s;
 }
 
@@ -127,7 +130,8 @@ std::vector<RunSpec> draw_runs(const Settings& settings) {
     RunSpec run;
     run.id = id;
     run.monitor_from = monitor_from;
-    run.scenario = draw_rig(rng, id, settings.seed * 100003 + id, settings.healthy_seconds);
+    run.scenario =
+        draw_rig(rng, id, settings.seed * 100003 + id, settings.healthy_seconds, settings.effects);
     runs.push_back(std::move(run));
   }
   for (double leak : settings.leak_sizes) {
@@ -138,8 +142,8 @@ std::vector<RunSpec> draw_runs(const Settings& settings) {
       run.leak = leak;
       // A healthy stretch after learning (false alarms count there too), then the leak.
       run.onset = monitor_from + uniform(rng, 20.0, 60.0);
-      run.scenario =
-          draw_rig(rng, id, settings.seed * 100003 + id, run.onset + settings.after_onset_seconds);
+      run.scenario = draw_rig(rng, id, settings.seed * 100003 + id,
+                              run.onset + settings.after_onset_seconds, settings.effects);
       run.scenario.effects.internal_leakage = sim::InternalLeakage{leak, run.onset, 0.0};
       runs.push_back(std::move(run));
     }
@@ -260,6 +264,16 @@ void add_run(Rates& rates, const RunResult& run, std::size_t c, std::size_t t,
 
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
 
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
 std::vector<double> parse_list(const std::string& text) {
   std::vector<double> values;
   std::stringstream in(text);
@@ -291,6 +305,8 @@ int run_evaluate(int argc, char** argv) {
       .option("after-onset", "S", "run length after the leak onset", "90")
       .option("seed", "N", "master seed", "1")
       .option("jobs", "N", "parallel runs", "2")
+      .option("effects", "LIST",
+              "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
       .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
       .option("plot-script", "PATH", "the plotting script", "docs/tools/detection_plots.py");
   if (!args.parse(argc, argv)) return 0;
@@ -304,6 +320,14 @@ int run_evaluate(int argc, char** argv) {
   settings.after_onset_seconds = args.get_double("after-onset");
   settings.seed = static_cast<std::uint64_t>(args.get_int("seed"));
   settings.jobs = static_cast<int>(args.get_int("jobs"));
+  settings.effects = split(args.get("effects"));
+  for (const auto& effect : settings.effects) {
+    try {
+      sim::Effects().enable(effect);
+    } catch (const std::exception& e) {
+      throw UsageError(fmt::format("option '--effects': {}", e.what()));
+    }
+  }
   if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.jobs < 1) {
     throw UsageError("run counts must be >= 0 and --jobs >= 1");
   }
@@ -391,9 +415,10 @@ int run_evaluate(int argc, char** argv) {
   f_json.print(
       "{{\n  \"settings\": {{\"healthy_runs\": {}, \"healthy_seconds\": {}, "
       "\"runs_per_leak\": {}, \"learn_seconds\": {}, \"seed\": {}, "
-      "\"detect_within\": {}}},\n  \"detectors\": [\n",
+      "\"detect_within\": {}, \"effects\": \"{}\"}},\n  \"detectors\": [\n",
       settings.healthy_runs, settings.healthy_seconds, settings.runs_per_leak,
-      settings.learn_seconds, settings.seed, settings.detect_within);
+      settings.learn_seconds, settings.seed, settings.detect_within,
+      fmt::join(settings.effects, ","));
   const std::vector<std::string> controllers = {"all", "basic", "fault_tolerant"};
   for (std::size_t c = 0; c < all.size(); ++c) {
     f_json.print(
