@@ -75,39 +75,6 @@ inline void decimate_rows(const double* newest, std::size_t count, std::size_t c
   for (; c < channels; ++c) decimate_channel_block<1>(newest, count, channels, filter, out, c);
 }
 
-// sum_i weights[i] * values[i] for `length` a multiple of 8, as eight partial sums (four SSE2
-// registers, so that no addition waits on the previous one).
-inline double dot_multiple_of_8(const double* weights, const double* values, std::size_t length) {
-  double lane[8] = {};
-  for (std::size_t i = 0; i < length; i += 8) {
-#pragma GCC unroll 8
-    for (std::size_t j = 0; j < 8; ++j) lane[j] += weights[i + j] * values[i + j];
-  }
-  return ((lane[0] + lane[1]) + (lane[2] + lane[3])) + ((lane[4] + lane[5]) + (lane[6] + lane[7]));
-}
-
-// sums[c] += sum_i weights[i] * rows[i * channels + c]: one weighted sum per channel over
-// `length` interleaved rows (the boundary map's rows), eight channels at a time.
-inline void add_weighted_rows(const double* weights, std::size_t length, const double* rows,
-                              std::size_t channels, double* sums) {
-  constexpr std::size_t kBlock = 8;
-  std::size_t c = 0;
-  for (; c + kBlock <= channels; c += kBlock) {
-    double sum[kBlock];
-    for (std::size_t b = 0; b < kBlock; ++b) sum[b] = sums[c + b];
-    for (std::size_t i = 0; i < length; ++i) {
-      const double weight = weights[i];
-      const double* __restrict__ row = rows + i * channels + c;
-#pragma GCC unroll 8
-      for (std::size_t b = 0; b < kBlock; ++b) sum[b] += weight * row[b];
-    }
-    for (std::size_t b = 0; b < kBlock; ++b) sums[c + b] = sum[b];
-  }
-  for (; c < channels; ++c) {
-    for (std::size_t i = 0; i < length; ++i) sums[c] += weights[i] * rows[i * channels + c];
-  }
-}
-
 inline void add_squares(const double* rows, std::size_t count, std::size_t channels,
                         double* energy) {
   if (channels == 1) {

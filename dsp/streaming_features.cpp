@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "dsp/boundary_map.hpp"
 #include "dsp/dwt.hpp"
+#include "dsp/extension.hpp"
 #include "dsp/interleaved_kernels.hpp"
 #include "dsp/row_history.hpp"
 #include "dsp/wavelet.hpp"
@@ -66,6 +66,37 @@ struct LevelPlan {
   std::size_t clean_hi = 0;
   std::size_t edge_left = 0;   // input values a[0, edge_left) held for the left boundary
   std::size_t edge_right = 0;  // input values a[n_in - edge_right, n_in) for the right one
+};
+
+// One extension value of one edge buffer, resolved at construction so that the per-window work
+// is a copy or a short formula over the channels: the same values, by the same arithmetic, as
+// extend_before_start/extend_after_end (the streaming-equals-batch tests check every mode).
+struct ExtensionSlot {
+  enum class Kind { zero, copy, negate, smooth, antireflect } kind = Kind::zero;
+  double* dst = nullptr;
+  const double* a = nullptr;  // copy/negate: source; smooth/antireflect: the edge value
+  const double* b = nullptr;  // smooth: the value next to the edge; antireflect: the mirrored one
+  double factor = 0.0;        // smooth: distance from the edge
+
+  void fill(std::size_t channels) const noexcept {
+    switch (kind) {
+      case Kind::zero:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = 0.0;
+        break;
+      case Kind::copy:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c];
+        break;
+      case Kind::negate:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = -a[c];
+        break;
+      case Kind::smooth:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] + factor * (a[c] - b[c]);
+        break;
+      case Kind::antireflect:
+        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] - (b[c] - a[c]);
+        break;
+    }
+  }
 };
 
 std::optional<std::vector<LevelPlan>> plan_incremental(const FeatureParams& params,
@@ -126,11 +157,12 @@ struct StreamingFeatures::Engine {
         const LevelPlan& l = levels[j];
         const std::size_t clean = l.clean_hi - l.clean_lo;
         coeffs.emplace_back(2 * clean + (params.step >> (j + 1)) + w.filter_length(), channels);
+        left_buf.emplace_back((l.dec.left_ext + l.edge_left) * channels);
+        right_buf.emplace_back((l.edge_right + l.dec.right_ext) * channels);
+        left_out.emplace_back(l.clean_lo * channels);
+        right_out.emplace_back((l.dec.n_out - l.clean_hi) * channels);
       }
-      const LevelPlan& top = levels.back();
-      boundary = BoundaryMap(params.window, w, params.mode, params.level, top.clean_lo,
-                             top.clean_hi, channels);
-      boundary_out.resize((boundary.left_count() + boundary.right_count()) * channels);
+      for (std::size_t j = 0; j < levels.size(); ++j) build_extension_recipe(j);
     } else {
       transform.emplace(params.window, w, params.mode, params.level);
       window_buf.resize(params.window);
@@ -148,15 +180,15 @@ struct StreamingFeatures::Engine {
     std::fill(latest.begin(), latest.end(), DetailFeature{});
   }
 
-  // Per sample only a copy into the history; NaN checks and all arithmetic run once per window,
-  // over the samples that arrived since the previous one.
+  // Per sample only a copy into the history; the NaN check and all arithmetic run once per
+  // window, over the samples that arrived since the previous one.
   bool push(std::span<const double> sample) noexcept {
     assert(sample.size() == channels);
     const std::uint64_t t = seen++;
     if (t < next_start) return false;  // step > window: this sample is in no window
     if (samples.end() != t) samples.restart(t);
     double* row = samples.append();
-    for (std::size_t c = 0; c < channels; ++c) row[c] = sample[c];  // no memmove call for a few
+    for (std::size_t c = 0; c < channels; ++c) row[c] = sample[c];
     if (seen != next_start + params.window) return false;
     const std::uint64_t start = next_start;
     note_gaps(std::max(gaps_checked, start), seen);
@@ -174,7 +206,8 @@ struct StreamingFeatures::Engine {
     return true;
   }
 
-  // gap_end[c] = one past the last NaN of channel c among samples [first, end) (in the history).
+  // gap_end[c] = one past the last NaN of channel c among samples [first, end) (in the history);
+  // samples before the window's start cannot invalidate it, so they need no look.
   void note_gaps(std::uint64_t first, std::uint64_t end) noexcept {
     const double* rows = samples.row(first);
     for (std::uint64_t t = first; t < end; ++t, rows += channels) {
@@ -199,15 +232,17 @@ struct StreamingFeatures::Engine {
     }
   }
 
-  // The clean coefficients of every level that this window adds, then the top level's boundary
-  // coefficients straight from the window's samples.
   void update_window(std::uint64_t start) noexcept {
+    const std::size_t row_bytes = channels * sizeof(double);
     for (std::size_t j = 0; j < levels.size(); ++j) {
       const LevelPlan& l = levels[j];
       const std::size_t level = j + 1;
       const RowHistory& input = j == 0 ? samples : coeffs[j - 1];
       RowHistory& output = coeffs[j];
+      const std::uint64_t in_origin = start >> j;
       const std::uint64_t out_origin = start >> level;
+
+      // New clean coefficients: those the previous window did not have.
       const std::uint64_t first = out_origin + l.clean_lo;
       const std::uint64_t last = out_origin + l.clean_hi;
       if (output.end() < first || output.empty()) output.restart(first);
@@ -217,18 +252,92 @@ struct StreamingFeatures::Engine {
         double* out = output.append(count);
         decimate_rows(input.row(2 * from + l.dec.phase), count, channels, l.filter, out);
       }
+
+      // The input's edges: boundary outputs of the level below, or clean history, or samples.
+      const std::size_t n_in = l.dec.n_in;
+      double* left_real = left_buf[j].data() + l.dec.left_ext * channels;
+      double* right_real = right_buf[j].data();
+      const std::size_t right_first = n_in - l.edge_right;
+      if (j == 0) {
+        std::memcpy(left_real, samples.row(start), l.edge_left * row_bytes);
+        std::memcpy(right_real, samples.row(start + right_first), l.edge_right * row_bytes);
+      } else {
+        const LevelPlan& below = levels[j - 1];
+        std::memcpy(left_real, left_out[j - 1].data(), below.clean_lo * row_bytes);
+        std::memcpy(left_real + below.clean_lo * channels, input.row(in_origin + below.clean_lo),
+                    (l.edge_left - below.clean_lo) * row_bytes);
+        std::memcpy(right_real, input.row(in_origin + right_first),
+                    (below.clean_hi - right_first) * row_bytes);
+        std::memcpy(right_real + (below.clean_hi - right_first) * channels, right_out[j - 1].data(),
+                    (n_in - below.clean_hi) * row_bytes);
+      }
+      for (std::size_t e = j == 0 ? 0 : extension_end[j - 1]; e < extension_end[j]; ++e) {
+        extension[e].fill(channels);
+      }
+
+      const std::size_t right_count = l.dec.n_out - l.clean_hi;
+      decimate_rows(left_buf[j].data() + (l.dec.left_ext + l.dec.phase) * channels, l.clean_lo,
+                    channels, l.filter, left_out[j].data());
+      decimate_rows(right_real + (2 * l.clean_hi + l.dec.phase - right_first) * channels,
+                    right_count, channels, l.filter, right_out[j].data());
       output.release_before(((start + params.step) >> level) + l.clean_lo);
     }
-    boundary.apply(samples.row(start), boundary_out.data());
 
     const LevelPlan& top = levels.back();
     const std::uint64_t origin = start >> levels.size();
-    const double* right_out = boundary_out.data() + boundary.left_count() * channels;
     std::fill(energy.begin(), energy.end(), 0.0);
-    add_squares(boundary_out.data(), boundary.left_count(), channels, energy.data());
+    add_squares(left_out.back().data(), top.clean_lo, channels, energy.data());
     add_squares(coeffs.back().row(origin + top.clean_lo), top.clean_hi - top.clean_lo, channels,
                 energy.data());
-    add_squares(right_out, boundary.right_count(), channels, energy.data());
+    add_squares(right_out.back().data(), top.dec.n_out - top.clean_hi, channels, energy.data());
+  }
+
+  // Resolves every extension value of level j's edge buffers to an ExtensionSlot. The plan
+  // guarantees a single reflection, so every value reads the edges' real rows.
+  void build_extension_recipe(std::size_t j) {
+    const LevelPlan& l = levels[j];
+    const std::size_t n = l.dec.n_in;
+    const std::size_t right_first = n - l.edge_right;
+    double* left_real = left_buf[j].data() + l.dec.left_ext * channels;
+    double* right_real = right_buf[j].data();
+    auto row = [&](std::size_t i) -> const double* {
+      if (i < l.edge_left) return left_real + i * channels;
+      if (i < right_first) throw std::logic_error("extension reads outside the edge buffers");
+      return right_real + (i - right_first) * channels;
+    };
+    // For the modes that only pick (and maybe negate) a sample, probe which one: a[i] = i + 1.
+    auto probe = [](std::size_t i) { return static_cast<double>(i) + 1.0; };
+    auto slot = [&](double* dst, std::size_t m, bool left) {
+      ExtensionSlot e;
+      e.dst = dst;
+      const std::size_t edge = left ? 0 : n - 1;
+      const std::size_t inward = left ? edge + 1 : edge - 1;
+      switch (params.mode) {
+        case Mode::zero:
+          break;
+        case Mode::smooth:
+          e = {ExtensionSlot::Kind::smooth, dst, row(edge), row(inward), static_cast<double>(m)};
+          break;
+        case Mode::antireflect:
+          e = {ExtensionSlot::Kind::antireflect, dst, row(edge), row(left ? edge + m : edge - m),
+               0.0};
+          break;
+        default: {
+          const double v = left ? extend_before_start(params.mode, n, m, probe)
+                                : extend_after_end(params.mode, n, m, probe);
+          e.kind = v < 0 ? ExtensionSlot::Kind::negate : ExtensionSlot::Kind::copy;
+          e.a = row(static_cast<std::size_t>(std::abs(v)) - 1);
+        }
+      }
+      extension.push_back(e);
+    };
+    for (std::size_t m = 1; m <= l.dec.left_ext; ++m) {
+      slot(left_real - m * channels, m, true);
+    }
+    for (std::size_t m = 1; m <= l.dec.right_ext; ++m) {
+      slot(right_real + (l.edge_right - 1 + m) * channels, m, false);
+    }
+    extension_end.push_back(extension.size());
   }
 
   FeatureParams params;
@@ -236,9 +345,10 @@ struct StreamingFeatures::Engine {
   const Wavelet& w;
   std::vector<LevelPlan> levels;  // empty: recompute every window
   RowHistory samples;
-  std::vector<RowHistory> coeffs;    // per level: its clean coefficients
-  BoundaryMap boundary;              // the top level's boundary coefficients from the samples
-  std::vector<double> boundary_out;  // their values for the current window, per channel
+  std::vector<RowHistory> coeffs;  // per level: its clean coefficients
+  std::vector<std::vector<double>> left_buf, right_buf, left_out, right_out;
+  std::vector<ExtensionSlot> extension;    // all levels' extension values, level by level
+  std::vector<std::size_t> extension_end;  // per level: one past its last slot
   std::optional<DetailTransform> transform;
   std::vector<double> window_buf;
   std::vector<double> energy;

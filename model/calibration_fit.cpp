@@ -13,7 +13,11 @@ namespace {
 // of them is a comparable change of the model.
 constexpr int kCalibrationCount = 4;  // beta, Kv, m, b
 constexpr double kScales[kCalibrationCount] = {1e8, 1e-7, 1.0, 100.0};
-constexpr double kFloors[kCalibrationCount] = {0.05, 0.05, 0.1, 0.0};  // keep the model sane
+// Bounds in solver units: twice MODEL.md's calibratable ranges (beta +-25 %, Kv +-10 %,
+// m +-20 %, b +-30 %), so that a discrepancy cannot be absorbed by an absurd calibration
+// (a 50 kg piston, say) instead of showing as an effect.
+constexpr double kLower[kCalibrationCount] = {3.5, 2.712, 6.0, 1.2};
+constexpr double kUpper[kCalibrationCount] = {10.5, 4.068, 14.0, 4.8};
 
 class SegmentFitProblem : public Eigen::DenseFunctor<double> {
  public:
@@ -53,7 +57,7 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
                                          &p.calibration.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       if (calibration_slot_[i] < 0) continue;
-      *values[i] = std::max(theta[calibration_slot_[i]], kFloors[i]) * kScales[i];
+      *values[i] = std::clamp(theta[calibration_slot_[i]], kLower[i], kUpper[i]) * kScales[i];
     }
     if (candidate_) candidate_->apply(p.effects, effect_values(theta));
     return p;

@@ -2,6 +2,7 @@
 // clear errors for unusable captures.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -39,11 +40,13 @@ TEST(ModelCli, ChecksACaptureAndWritesJsonAndReport) {
             0)
       << read_file(dir + "/log.txt");
   // The JSON is read back by Python's parser, the way other tools consume it.
+  char true_value[32];
+  std::snprintf(true_value, sizeof true_value, "%.9g", c.main_value);
   const std::string check = test::python() +
                             " -c \"import json,sys; r=json.load(open(sys.argv[1])); "
                             "assert r['cause']=='internal_leakage', r['cause']; "
                             "assert abs(r['params']['C_L']/" +
-                            std::to_string(c.main_value) +
+                            true_value +
                             "-1)<0.25; "
                             "assert set(r['calibrated'])=={'beta','Kv','m','b'}; "
                             "assert len(r['ranking'])==11; "
