@@ -317,8 +317,10 @@ void Daemon::reload() {
                                   : "running (reload rejected, see log)");
 }
 
-int Daemon::run() {
+int Daemon::run(double duration_s) {
   start();
+  const std::int64_t deadline_ns =
+      duration_s > 0 ? started_ns_ + static_cast<std::int64_t>(duration_s * 1e9) : 0;
   notifier_.ready(fmt::format("running: {} actuator(s), {} sampling group(s)",
                               config_.actuators.size(), groups_.size()));
   spdlog::info("running");
@@ -338,6 +340,10 @@ int Daemon::run() {
     housekeeping(monotonic_now_ns());
     if (all_sources_ended()) {
       spdlog::info("every source has ended: stopping");
+      break;
+    }
+    if (deadline_ns > 0 && monotonic_now_ns() >= deadline_ns) {
+      spdlog::info("--duration {} s reached: stopping", duration_s);
       break;
     }
   }

@@ -30,9 +30,10 @@ class Daemon {
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;
 
-  // Runs until SIGTERM/SIGINT (or the end of every finite source). Returns the exit code.
+  // Runs until SIGTERM/SIGINT, the end of every finite source, or `duration_s` seconds (when
+  // positive), whichever comes first; each ends in the same clean stop. Returns the exit code.
   // Throws config::ConfigError / io::DriverError when the configuration cannot start.
-  int run();
+  int run(double duration_s = 0);
 
   // Prometheus text exposition of everything the daemon counts.
   std::string metrics_text() const;

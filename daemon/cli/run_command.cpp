@@ -22,10 +22,14 @@ int run_run(int argc, char** argv) {
   ArgParser args("run", "run the leak monitoring daemon");
   args.option("config", "CONFIG.yaml", "configuration file (schema: config/README.md)",
               std::nullopt, true);
+  args.option("duration", "SECONDS",
+              "stop cleanly after this long, as on SIGTERM (0: run until stopped)", "0");
   if (!args.parse(argc, argv)) return 0;
+  const double duration_s = args.get_double("duration");
+  if (!(duration_s >= 0)) throw UsageError("--duration must be 0 or a positive number of seconds");
   configure_daemon_logging();
   daemon::Daemon service(args.get("config"));
-  return service.run();
+  return service.run(duration_s);
 }
 
 }  // namespace leakmon::cli
