@@ -195,11 +195,7 @@ struct StreamingFeatures::Engine {
     if (levels.empty()) {
       recompute_window(start);
     } else {
-      if (channels == 1) {
-        update_one_channel_window(start);
-      } else {
-        update_window(start);
-      }
+      update_window(start);
     }
     for (std::size_t c = 0; c < channels; ++c) {
       latest[c] =
@@ -236,14 +232,7 @@ struct StreamingFeatures::Engine {
     }
   }
 
-  // The same update built twice for one channel (baseline SSE2 and AVX2, picked at load time by
-  // the CPU); no FMA, so the rounding is the same. (For many channels AVX2 measured slower.)
-  __attribute__((target_clones("avx2", "default"))) void update_one_channel_window(
-      std::uint64_t start) noexcept {
-    update_window(start);
-  }
-
-  __attribute__((always_inline)) void update_window(std::uint64_t start) noexcept {
+  void update_window(std::uint64_t start) noexcept {
     const std::size_t row_bytes = channels * sizeof(double);
     for (std::size_t j = 0; j < levels.size(); ++j) {
       const LevelPlan& l = levels[j];
