@@ -280,7 +280,6 @@ struct StreamingFeatures::Engine {
                     channels, l.filter, left_out[j].data());
       decimate_rows(right_real + (2 * l.clean_hi + l.dec.phase - right_first) * channels,
                     right_count, channels, l.filter, right_out[j].data());
-      output.release_before(((start + params.step) >> level) + l.clean_lo);
     }
 
     const LevelPlan& top = levels.back();
@@ -290,6 +289,11 @@ struct StreamingFeatures::Engine {
     add_squares(coeffs.back().row(origin + top.clean_lo), top.clean_hi - top.clean_lo, channels,
                 energy.data());
     add_squares(right_out.back().data(), top.dec.n_out - top.clean_hi, channels, energy.data());
+    // Only now, after the level above and the energy sum have read them, may each level drop the
+    // coefficients that the next window no longer needs.
+    for (std::size_t j = 0; j < levels.size(); ++j) {
+      coeffs[j].release_before(((start + params.step) >> (j + 1)) + levels[j].clean_lo);
+    }
   }
 
   // Resolves every extension value of level j's edge buffers to an ExtensionSlot. The plan

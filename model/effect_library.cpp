@@ -76,12 +76,8 @@ std::vector<EffectCandidate> effect_library(double ripple_hz) {
   for (const char* chamber : {"chamber 1", "chamber 2"}) {
     out.push_back({"external_leakage", chamber, {{"C_E", 1e-12, 5e-13, -1e-12, 2e-11}}});
   }
-  out.push_back({"coulomb_friction",
-                 "",
-                 {{"F_C", 100.0, 100.0, -200.0, 4000.0}},
-                 {false, false, false, true}});
-  out.push_back(
-      {"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}}, {true, false, false, false}});
+  out.push_back({"coulomb_friction", "", {{"F_C", 100.0, 100.0, -200.0, 4000.0}}});
+  out.push_back({"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}}});
   out.push_back({"valve_overlap", "", {{"d", 0.01, 0.01, -0.01, 0.2}}});
   out.push_back({"valve_bias", "", {{"u0", 0.1, 0.02, -3.0, 3.0}}});
   out.push_back({"spool_lag", "", {{"tau", 0.005, 0.006, 5e-4, 0.1}}});
@@ -92,8 +88,7 @@ std::vector<EffectCandidate> effect_library(double ripple_hz) {
                     {"f", 1e-3, ripple_hz, ripple_hz - 1.0, ripple_hz + 1.0},
                     {"", 1e5, 0.0, -5e6, 5e6}}});
   }
-  out.push_back(
-      {"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}}, {false, true, false, false}});
+  out.push_back({"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}}});
   for (const char* channel : {"p1", "p2"}) {
     out.push_back({"sensor_offset", channel, {{"offset", 1e5, 0.0, -3e6, 3e6}}});
   }

@@ -3,7 +3,6 @@
 // physical bounds and a starting value. Effects are named verbatim as in MODEL.md.
 #pragma once
 
-#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,9 +23,6 @@ struct EffectCandidate {
   std::string effect;                     // MODEL.md's name
   std::string variant;                    // "chamber 2", "p1", ... ; empty when the effect has none
   std::vector<FreeParameter> parameters;  // the first one is the effect's main parameter
-  // Calibration parameters (beta, Kv, m, b) whose effect on the signals resembles this one's:
-  // screening frees them too, or the calibration would already have absorbed the effect.
-  std::array<bool, 4> partners = {false, false, false, false};
   // Writes the discrete settings and parameter values into `e`.
   void apply(EffectParameters& e, const std::vector<double>& values) const;
   // Is a fitted main parameter a physical instance of the effect (e.g. a leak, not a source)?
