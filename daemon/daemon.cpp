@@ -194,6 +194,10 @@ void Daemon::start() {
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
   }
+  if (!config_.event_log.empty()) spdlog::info("events: {}", config_.event_log);
+  if (!config_.recording.directory.empty()) {
+    spdlog::info("recording raw samples under {}", config_.recording.directory);
+  }
   started_ns_ = monotonic_now_ns();
 }
 
