@@ -188,8 +188,8 @@ static std::string resolve_path(const config::ConfigNode& node, const std::strin
 }
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
-  root.expect_keys(
-      {"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs", "worker"});
+  root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs",
+                    "worker", "realtime"});
   DaemonConfig config;
   config.source = root.source();
 
@@ -248,6 +248,11 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     worker->expect_keys({"priority", "poll_us"});
     config.worker_priority = static_cast<int>(worker->get_int("priority", 70, 0, 99));
     config.worker_poll_ns = worker->get_int("poll_us", 500, 50, 100000) * 1000;
+  }
+  if (auto realtime = root.find("realtime")) {
+    realtime->expect_keys({"cpu_wakeup_latency_us"});
+    config.cpu_wakeup_latency_us = static_cast<int>(
+        realtime->get_int("cpu_wakeup_latency_us", config.cpu_wakeup_latency_us, -1, 1'000'000));
   }
   if (auto outputs = root.find("outputs")) {
     std::set<std::string> output_names;

@@ -80,6 +80,10 @@ struct DaemonConfig {
   // SCHED_FIFO priority of the worker thread (below the loops'), so that decisions and alarm
   // events keep their latency on a loaded machine; 0 keeps normal scheduling.
   int worker_priority = 70;
+  // Longest CPU idle-state exit the daemon tolerates [us], requested through
+  // /dev/cpu_dma_latency while it runs (0: CPUs never sleep deeper than polling, as cyclictest
+  // asks); negative: no request, the power management stays as the system has it.
+  int cpu_wakeup_latency_us = 0;
 };
 
 // Parses and validates; throws config::ConfigError with `file:line:column: path: message`.

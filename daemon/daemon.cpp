@@ -51,6 +51,7 @@ std::string acquisition_signature(const DaemonConfig& config) {
                       config.recording.flush_seconds);
   text += fmt::format("metrics {}:{}\n", config.metrics.address, config.metrics.port);
   text += fmt::format("worker {} {}\n", config.worker_priority, config.worker_poll_ns);
+  text += fmt::format("realtime {}\n", config.cpu_wakeup_latency_us);
   return text;
 }
 
@@ -118,6 +119,10 @@ void Daemon::start() {
   pthread_attr_destroy(&attr);
   if (const std::string warning = lock_process_memory(); !warning.empty()) {
     spdlog::warn("{}", warning);
+  }
+  if (config_.cpu_wakeup_latency_us >= 0) {
+    cpu_latency_ = CpuLatencyRequest(config_.cpu_wakeup_latency_us);
+    if (!cpu_latency_.held()) spdlog::warn("{}", cpu_latency_.warning());
   }
 
   for (const auto& driver : config_.drivers) {
@@ -294,11 +299,11 @@ void Daemon::reload() {
   try {
     DaemonConfig next = check_config(config_path_);
     if (acquisition_signature(next) != acquisition_signature(config_)) {
-      throw config::ConfigError(
-          fmt::format("{}: drivers, sampling groups, recording, metrics or worker changed; these "
-                      "need a restart "
-                      "(systemctl restart leakmon)",
-                      config_path_));
+      throw config::ConfigError(fmt::format(
+          "{}: drivers, sampling groups, recording, metrics, worker or realtime changed; these "
+          "need a restart "
+          "(systemctl restart leakmon)",
+          config_path_));
     }
     auto sinks = build_sinks(next);
     worker_->apply(next, raw(sinks));
@@ -407,6 +412,11 @@ std::string Daemon::metrics_text() const {
   counter("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
           [](const Group& g) { return g.realtime.fifo ? 1 : 0; });
 
+  out +=
+      "# HELP leakmon_cpu_wakeup_latency_request_held 1 while the CPU wake-up latency request "
+      "(/dev/cpu_dma_latency) is held\n"
+      "# TYPE leakmon_cpu_wakeup_latency_request_held gauge\n";
+  out += fmt::format("leakmon_cpu_wakeup_latency_request_held {}\n", cpu_latency_.held() ? 1 : 0);
   out +=
       "# HELP leakmon_samples_processed_total samples the worker consumed\n"
       "# TYPE leakmon_samples_processed_total counter\n";

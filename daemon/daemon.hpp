@@ -15,6 +15,7 @@
 
 #include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
+#include "daemon/cpu_latency_request.hpp"
 #include "daemon/event.hpp"
 #include "daemon/http_endpoint.hpp"
 #include "daemon/service_notifier.hpp"
@@ -73,6 +74,7 @@ class Daemon {
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<HttpEndpoint> endpoint_;
+  CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};
   std::atomic<bool> stop_worker_{false};

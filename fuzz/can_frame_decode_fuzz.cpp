@@ -10,34 +10,25 @@
 #include <string>
 #include <vector>
 
+#include "fuzz/fuzz_input.hpp"
 #include "io/can/bus_state.hpp"
 #include "io/can/frame_decoder.hpp"
 #include "io/can/signal.hpp"
 
 using namespace leakmon::io::can;
+using leakmon::fuzz::FuzzInput;
 
 namespace {
 
-// Consumes bytes from the front of the input; zeros once it runs out.
-struct Input {
-  const std::uint8_t* data;
-  std::size_t size;
-  std::uint8_t byte() {
-    if (size == 0) return 0;
-    --size;
-    return *data++;
-  }
-  std::uint16_t u16() { return static_cast<std::uint16_t>(byte() | (byte() << 8)); }
-};
-
-SignalLayout layout_from(Input& in) {
+SignalLayout layout_from(FuzzInput& in) {
   SignalLayout s;
   const std::uint8_t flags = in.byte();
   s.byte_order = (flags & 1) ? ByteOrder::motorola : ByteOrder::intel;
   s.is_signed = (flags & 2) != 0;
   s.extended = (flags & 4) != 0;
-  s.id = in.u16() & (s.extended ? kExtendedIdMask : kStandardIdMask);
-  s.start_bit = in.u16() % 600;  // beyond 511 on purpose: layout_problem must catch it
+  s.id = in.u16_little_endian() & (s.extended ? kExtendedIdMask : kStandardIdMask);
+  s.start_bit =
+      in.u16_little_endian() % 600;  // beyond 511 on purpose: layout_problem must catch it
   s.length = in.byte() % 70;
   s.factor = 1.0 + in.byte();
   return s;
@@ -46,14 +37,14 @@ SignalLayout layout_from(Input& in) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  Input in{data, size};
+  FuzzInput in(data, size);
   std::vector<SignalDef> defs;
   const unsigned signals = 1 + in.byte() % 8;
   for (unsigned i = 0; i < signals; ++i) {
     SignalDef def;
     def.channel = "s" + std::to_string(i);
     def.layout = layout_from(in);
-    def.max_age_ns = in.u16();
+    def.max_age_ns = in.u16_little_endian();
     if (!layout_problem(def.layout).empty()) continue;
     defs.push_back(def);
   }
@@ -61,20 +52,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FrameDecoder decoder(defs);
   std::vector<double> values(defs.size());
   std::int64_t now = 0;
-  while (in.size > 0) {
+  while (in.remaining() > 0) {
     CanFrame frame;
     const std::uint8_t flags = in.byte();
     frame.extended = (flags & 1) != 0;
     frame.remote = (flags & 2) != 0;
     frame.error = (flags & 4) != 0;
     frame.fd = (flags & 8) != 0;
-    frame.id = (flags & 16) ? defs[in.byte() % defs.size()].layout.id : in.u16();
+    frame.id = (flags & 16) ? defs[in.byte() % defs.size()].layout.id : in.u16_little_endian();
     if (flags & 16) frame.extended = defs[0].layout.extended;
     frame.length = in.byte();  // may exceed 64: the decoders must not trust it
-    const std::size_t copy = std::min<std::size_t>({in.size, frame.data.size(), frame.length});
-    std::memcpy(frame.data.data(), in.data, copy);
-    in.data += copy;
-    in.size -= copy;
+    in.take(frame.data.data(), std::min<std::size_t>(frame.data.size(), frame.length));
     for (const auto& def : defs) {
       double value = 0;
       const bool decoded = decode(def.layout, frame, value);

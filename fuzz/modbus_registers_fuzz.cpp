@@ -12,23 +12,14 @@
 #include <cstdlib>
 #include <vector>
 
+#include "fuzz/fuzz_input.hpp"
 #include "io/modbus/register_decoding.hpp"
 #include "io/modbus/request_plan.hpp"
 
 using namespace leakmon::io::modbus;
+using leakmon::fuzz::FuzzInput;
 
 namespace {
-
-struct Input {
-  const std::uint8_t* data;
-  std::size_t size;
-  std::uint8_t byte() {
-    if (size == 0) return 0;
-    --size;
-    return *data++;
-  }
-  std::uint16_t u16() { return static_cast<std::uint16_t>(byte() << 8 | byte()); }
-};
 
 void require(bool condition) {
   if (!condition) std::abort();
@@ -36,12 +27,12 @@ void require(bool condition) {
 
 std::uint16_t swapped(std::uint16_t w) { return static_cast<std::uint16_t>(w << 8 | w >> 8); }
 
-void check_decoding(Input& in) {
+void check_decoding(FuzzInput& in) {
   const auto type = static_cast<DataType>(in.byte() % 6);
   const auto order = static_cast<ByteOrder>(in.byte() % 4);
   const std::size_t given = in.byte() % 6;  // sometimes fewer words than the type needs
   std::vector<std::uint16_t> words(given);
-  for (auto& w : words) w = in.u16();
+  for (auto& w : words) w = in.u16_big_endian();
   const std::size_t n = register_count(type);
   const double value = decode_registers(words, type, order);
   if (given < n) {
@@ -76,7 +67,7 @@ void check_decoding(Input& in) {
   same(decode_registers(swapped_words, type, ByteOrder::badc));
 }
 
-void check_plan(Input& in) {
+void check_plan(FuzzInput& in) {
   const std::size_t count = in.byte() % 40;
   const int limit = 4 + in.byte() % 122;
   std::vector<ChannelSpec> channels(count);
@@ -84,7 +75,7 @@ void check_plan(Input& in) {
     c.unit_id = in.byte() % 3;
     c.register_type = static_cast<RegisterType>(in.byte() % 4);
     c.data_type = static_cast<DataType>(in.byte() % 6);
-    c.address = in.u16() % 300;  // dense enough to merge often
+    c.address = in.u16_big_endian() % 300;  // dense enough to merge often
   }
   const auto plan = plan_requests(channels, limit);
   std::vector<int> seen(count, 0);
@@ -107,7 +98,7 @@ void check_plan(Input& in) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  Input in{data, size};
+  FuzzInput in(data, size);
   if (in.byte() % 2 == 0) {
     check_decoding(in);
   } else {

@@ -2,7 +2,9 @@
 // (the sim driver, i.e. the rig model stepped in real time) and the worker draining the ring,
 // as in the daemon. Prints wake-up latency min/avg/p99/max, overruns, missed cycles, ring drops
 // and the sample-to-decision latency (the path alarm events take), one `key value` per line.
-//   leakmon_loop_latency SECONDS [PERIOD_US] [PRIORITY] [ACTUATORS]
+// Like the daemon it holds the CPU wake-up latency request (CPU_WAKEUP_US, default 0 as in
+// the daemon's config; -1 = none, to see what idle-state exits cost).
+//   leakmon_loop_latency SECONDS [PERIOD_US] [PRIORITY] [ACTUATORS] [CPU_WAKEUP_US]
 #include <fmt/format.h>
 #include <sys/resource.h>
 
@@ -13,6 +15,7 @@
 #include "config/yaml_reader.hpp"
 #include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
+#include "daemon/cpu_latency_request.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/worker.hpp"
 #include "io/sim/sim_driver.hpp"
@@ -24,6 +27,7 @@ int main(int argc, char** argv) {
   const std::int64_t period_ns = (argc > 2 ? std::atoll(argv[2]) : 2000) * 1000;
   const int priority = argc > 3 ? std::atoi(argv[3]) : 80;
   const int actuators = argc > 4 ? std::atoi(argv[4]) : 1;
+  const int cpu_wakeup_us = argc > 5 ? std::atoi(argv[5]) : 0;
 
   std::string yaml = "drivers:\n";
   for (int i = 0; i < actuators; ++i) {
@@ -50,6 +54,8 @@ int main(int argc, char** argv) {
     for (const auto& c : drivers.back()->channels()) channels.push_back({d.name, c, std::nullopt});
   }
   const std::string lock_warning = daemon::lock_process_memory();
+  daemon::CpuLatencyRequest cpu_latency;
+  if (cpu_wakeup_us >= 0) cpu_latency = daemon::CpuLatencyRequest(cpu_wakeup_us);
   daemon::SpscRing<daemon::Sample> ring(8192);
   daemon::AcquisitionLoop loop(period_ns, raw, ring);
   daemon::CollectingEventSink events;
@@ -82,9 +88,10 @@ int main(int argc, char** argv) {
   const auto& d = worker.decision_latency();
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  fmt::print("channels {}\nperiod_us {}\nsched_fifo {}\nmlockall {}\ncycles {}\n",
-             loop.channel_count(), period_ns / 1000, report.fifo ? 1 : 0,
-             lock_warning.empty() ? 1 : 0, c.cycles.load());
+  fmt::print(
+      "channels {}\nperiod_us {}\nsched_fifo {}\nmlockall {}\ncpu_wakeup_request {}\ncycles {}\n",
+      loop.channel_count(), period_ns / 1000, report.fifo ? 1 : 0, lock_warning.empty() ? 1 : 0,
+      cpu_latency.held() ? cpu_wakeup_us : -1, c.cycles.load());
   fmt::print(
       "wakeup_min_us {:.1f}\nwakeup_avg_us {:.1f}\nwakeup_p99_us {:.1f}\nwakeup_max_us {:.1f}\n",
       static_cast<double>(w.min_ns()) / 1e3, w.mean_ns() / 1e3,
