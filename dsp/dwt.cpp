@@ -31,6 +31,7 @@ Decimation decimation(std::size_t n_in, std::size_t filter_len, Mode mode) {
   d.left_ext = filter_len - 1 > d.phase ? filter_len - 1 - d.phase : 0;
   const std::size_t last_read = d.n_out == 0 ? 0 : 2 * (d.n_out - 1) + d.phase;
   d.right_ext = last_read + 1 > n_in ? last_read + 1 - n_in : 0;
+  d.reverse_right_overhang = mode != Mode::zero && mode != Mode::constant && mode != Mode::smooth;
   return d;
 }
 
@@ -48,8 +49,11 @@ void decimate(std::span<const double> signal, std::span<const double> filter, Mo
   const std::size_t taps = filter.size();
   for (std::size_t k = 0; k < d.n_out; ++k) {
     const double* newest = scratch.data() + d.left_ext + 2 * k + d.phase;
+    const std::size_t reversed = std::min(d.reversed_taps(k), taps);
     double sum = 0.0;
-    for (std::size_t f = 0; f < taps; ++f)
+    for (std::size_t f = reversed; f-- > 0;)
+      sum += filter[f] * newest[-static_cast<std::ptrdiff_t>(f)];
+    for (std::size_t f = reversed; f < taps; ++f)
       sum += filter[f] * newest[-static_cast<std::ptrdiff_t>(f)];
     out[k] = sum;
   }

@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "dsp/dwt.hpp"
-#include "dsp/extension.hpp"
+#include "dsp/incremental_plan.hpp"
 #include "dsp/interleaved_kernels.hpp"
 #include "dsp/row_history.hpp"
 #include "dsp/wavelet.hpp"
@@ -46,102 +46,6 @@ void validate(const FeatureParams& params) {
         fmt::format("mode: value {} is not an extension mode", static_cast<int>(params.mode)));
   }
 }
-
-namespace {
-
-DetailFeature feature_from_energy(double energy, std::size_t count) {
-  return {std::sqrt(energy / static_cast<double>(count)), energy, true};
-}
-
-// One level of the incremental scheme. At window start s (a multiple of 2^level), output k of
-// this level equals the coefficient at absolute position (s >> level) + k of the transform of
-// the unbounded stream whenever its taps read no extended input: that "clean" range
-// [clean_lo, clean_hi) is computed once per position and kept in a RowHistory. Only the
-// boundary outputs, which read the mode's extension, are recomputed per window, from copies of
-// the input's two edges.
-struct LevelPlan {
-  Decimation dec;
-  std::span<const double> filter;  // dec_lo below the feature level, dec_hi at it
-  std::size_t clean_lo = 0;
-  std::size_t clean_hi = 0;
-  std::size_t edge_left = 0;   // input values a[0, edge_left) held for the left boundary
-  std::size_t edge_right = 0;  // input values a[n_in - edge_right, n_in) for the right one
-};
-
-// One extension value of one edge buffer, resolved at construction so that the per-window work
-// is a copy or a short formula over the channels: the same values, by the same arithmetic, as
-// extend_before_start/extend_after_end (the streaming-equals-batch tests check every mode).
-struct ExtensionSlot {
-  enum class Kind { zero, copy, negate, smooth, antireflect } kind = Kind::zero;
-  double* dst = nullptr;
-  const double* a = nullptr;  // copy/negate: source; smooth/antireflect: the edge value
-  const double* b = nullptr;  // smooth: the value next to the edge; antireflect: the mirrored one
-  double factor = 0.0;        // smooth: distance from the edge
-
-  void fill(std::size_t channels) const noexcept {
-    switch (kind) {
-      case Kind::zero:
-        for (std::size_t c = 0; c < channels; ++c) dst[c] = 0.0;
-        break;
-      case Kind::copy:
-        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c];
-        break;
-      case Kind::negate:
-        for (std::size_t c = 0; c < channels; ++c) dst[c] = -a[c];
-        break;
-      case Kind::smooth:
-        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] + factor * (a[c] - b[c]);
-        break;
-      case Kind::antireflect:
-        for (std::size_t c = 0; c < channels; ++c) dst[c] = a[c] - (b[c] - a[c]);
-        break;
-    }
-  }
-};
-
-std::optional<std::vector<LevelPlan>> plan_incremental(const FeatureParams& params,
-                                                       const Wavelet& w) {
-  const std::size_t taps = w.filter_length();
-  const std::size_t decimation_period = std::size_t{1} << params.level;
-  if (params.step % decimation_period != 0) return std::nullopt;  // phase would change
-  std::vector<LevelPlan> plan;
-  std::size_t n_in = params.window;
-  std::size_t prev_lo = 0;
-  std::size_t prev_hi = params.window;
-  for (int level = 1; level <= params.level; ++level) {
-    LevelPlan p;
-    p.dec = decimation(n_in, taps, params.mode);
-    p.filter = level < params.level ? w.dec_lo : w.dec_hi;
-    if (n_in < taps) return std::nullopt;  // extension would reflect more than once
-    const auto phase = static_cast<long long>(p.dec.phase);
-    const long long lowest = static_cast<long long>(prev_lo + taps - 1) - phase;
-    p.clean_lo = lowest <= 0 ? 0 : static_cast<std::size_t>((lowest + 1) / 2);
-    const long long highest = static_cast<long long>(prev_hi) - 1 - phase;
-    if (highest < 0) return std::nullopt;
-    p.clean_hi = std::min(p.dec.n_out, static_cast<std::size_t>(highest / 2 + 1));
-    if (p.clean_lo >= p.clean_hi) return std::nullopt;
-    const std::size_t left_reads = p.clean_lo == 0 ? 0 : 2 * (p.clean_lo - 1) + p.dec.phase + 1;
-    const long long first_right_read =
-        static_cast<long long>(2 * p.clean_hi + p.dec.phase) - static_cast<long long>(taps - 1);
-    const std::size_t right_reads =
-        first_right_read >= static_cast<long long>(n_in)
-            ? 0
-            : n_in - static_cast<std::size_t>(std::max(0LL, first_right_read));
-    p.edge_left = std::max(taps, left_reads);
-    p.edge_right = std::max(taps, right_reads);
-    if (p.edge_left > prev_hi || p.edge_right > n_in - prev_lo || p.edge_left > n_in ||
-        p.edge_right > n_in) {
-      return std::nullopt;
-    }
-    plan.push_back(p);
-    prev_lo = p.clean_lo;
-    prev_hi = p.clean_hi;
-    n_in = p.dec.n_out;
-  }
-  return plan;
-}
-
-}  // namespace
 
 struct StreamingFeatures::Engine {
   Engine(const FeatureParams& p, std::size_t channel_count)
@@ -278,8 +182,9 @@ struct StreamingFeatures::Engine {
       const std::size_t right_count = l.dec.n_out - l.clean_hi;
       decimate_rows(left_buf[j].data() + (l.dec.left_ext + l.dec.phase) * channels, l.clean_lo,
                     channels, l.filter, left_out[j].data());
-      decimate_rows(right_real + (2 * l.clean_hi + l.dec.phase - right_first) * channels,
-                    right_count, channels, l.filter, right_out[j].data());
+      decimate_rows_right_end(right_real + (2 * l.clean_hi + l.dec.phase - right_first) * channels,
+                              right_count, channels, l.filter, l.dec, l.clean_hi,
+                              right_out[j].data());
     }
 
     const LevelPlan& top = levels.back();
@@ -296,51 +201,10 @@ struct StreamingFeatures::Engine {
     }
   }
 
-  // Resolves every extension value of level j's edge buffers to an ExtensionSlot. The plan
-  // guarantees a single reflection, so every value reads the edges' real rows.
   void build_extension_recipe(std::size_t j) {
     const LevelPlan& l = levels[j];
-    const std::size_t n = l.dec.n_in;
-    const std::size_t right_first = n - l.edge_right;
-    double* left_real = left_buf[j].data() + l.dec.left_ext * channels;
-    double* right_real = right_buf[j].data();
-    auto row = [&](std::size_t i) -> const double* {
-      if (i < l.edge_left) return left_real + i * channels;
-      if (i < right_first) throw std::logic_error("extension reads outside the edge buffers");
-      return right_real + (i - right_first) * channels;
-    };
-    // For the modes that only pick (and maybe negate) a sample, probe which one: a[i] = i + 1.
-    auto probe = [](std::size_t i) { return static_cast<double>(i) + 1.0; };
-    auto slot = [&](double* dst, std::size_t m, bool left) {
-      ExtensionSlot e;
-      e.dst = dst;
-      const std::size_t edge = left ? 0 : n - 1;
-      const std::size_t inward = left ? edge + 1 : edge - 1;
-      switch (params.mode) {
-        case Mode::zero:
-          break;
-        case Mode::smooth:
-          e = {ExtensionSlot::Kind::smooth, dst, row(edge), row(inward), static_cast<double>(m)};
-          break;
-        case Mode::antireflect:
-          e = {ExtensionSlot::Kind::antireflect, dst, row(edge), row(left ? edge + m : edge - m),
-               0.0};
-          break;
-        default: {
-          const double v = left ? extend_before_start(params.mode, n, m, probe)
-                                : extend_after_end(params.mode, n, m, probe);
-          e.kind = v < 0 ? ExtensionSlot::Kind::negate : ExtensionSlot::Kind::copy;
-          e.a = row(static_cast<std::size_t>(std::abs(v)) - 1);
-        }
-      }
-      extension.push_back(e);
-    };
-    for (std::size_t m = 1; m <= l.dec.left_ext; ++m) {
-      slot(left_real - m * channels, m, true);
-    }
-    for (std::size_t m = 1; m <= l.dec.right_ext; ++m) {
-      slot(right_real + (l.edge_right - 1 + m) * channels, m, false);
-    }
+    append_extension_slots(l, params.mode, left_buf[j].data() + l.dec.left_ext * channels,
+                           right_buf[j].data(), channels, extension);
     extension_end.push_back(extension.size());
   }
 

@@ -1,11 +1,14 @@
-// Streaming feature throughput (db8, level 2, window 400, step 20) for 1 and 64 channels,
-// against a naive full recomputation of every window by the same library. Items are samples
+// Streaming feature throughput (db8, level 2, window 400, step 20) for 1 and 64 channels
+// (StreamingFeatures, one instant per call) and for 1 channel in blocks (BlockFeatures), against
+// a naive full recomputation of every window by the same library. Items are samples
 // (one channel's value at one instant), so items_per_second is samples/s summed over channels.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
+#include "dsp/block_features.hpp"
 #include "dsp/dwt.hpp"
 #include "dsp/streaming_features.hpp"
 #include "dsp/wavelet.hpp"
@@ -48,6 +51,34 @@ BENCHMARK(BM_StreamingFeatures)
     ->Args({1, 20})
     ->Args({64, 20})
     ->Args({1, 10})  // phase-changing step: the full-recomputation fallback
+    ->Unit(benchmark::kMillisecond);
+
+// One channel through BlockFeatures (kLanes windows at a time), `block` samples per call: the
+// whole run (offline analysis of a capture), or short blocks such as an acquisition loop's.
+void BM_BlockFeatures(benchmark::State& state) {
+  FeatureParams params;
+  params.step = static_cast<std::size_t>(state.range(0));
+  const auto block = static_cast<std::size_t>(state.range(1));
+  const auto x = pressures(1);
+  leakmon::dsp::BlockFeatures features(params);
+  double sink = 0.0;
+  for (auto _ : state) {
+    for (std::size_t from = 0; from < kInstants; from += block) {
+      features.push_block(
+          std::span<const double>(x).subspan(from, std::min(block, kInstants - from)),
+          [&](const leakmon::dsp::WindowFeature& f) { sink += f.feature.rms; });
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+  state.counters["incremental"] = features.incremental() ? 1 : 0;
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kInstants));
+}
+BENCHMARK(BM_BlockFeatures)
+    ->ArgNames({"step", "block"})
+    ->Args({20, kInstants})
+    ->Args({20, 160})        // 8 hops: one batch of kLanes windows per call
+    ->Args({20, 20})         // one window per call: 1 of the kLanes lanes used
+    ->Args({10, kInstants})  // phase-changing step: StreamingFeatures, one sample at a time
     ->Unit(benchmark::kMillisecond);
 
 // Every window recomputed from scratch: the whole wavedec to `level` for each channel's window.

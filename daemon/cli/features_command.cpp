@@ -1,9 +1,10 @@
 // `leakmon features`: the sliding-window wavelet index of one capture channel, as FORMATS.md
-// specifies. The capture is streamed row by row through the same StreamingFeatures the daemon
-// uses, so captures larger than memory work and the CLI shows exactly what the daemon computes.
+// specifies. The capture is read in chunks of rows and each chunk goes through BlockFeatures,
+// which gives the same windows and values as the daemon's StreamingFeatures (tests/dsp check
+// both against the batch transform and PyWavelets) several windows at a time; captures larger
+// than memory work.
 #include <fmt/format.h>
 
-#include <array>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,7 @@
 
 #include "daemon/cli/args.hpp"
 #include "daemon/cli/subcommands.hpp"
+#include "dsp/block_features.hpp"
 #include "dsp/streaming_features.hpp"
 #include "io/capture/capture.hpp"
 
@@ -79,23 +81,39 @@ int run_features(int argc, char** argv) {
   if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", out_path));
   std::string text = "t,rms\n";
 
-  dsp::StreamingFeatures features(params, 1);
+  dsp::BlockFeatures features(params);
   std::vector<double> row(reader.columns().size());
+  // One chunk of the channel and its times: a window completes while its last sample's chunk is
+  // being pushed, so its time is in `times`.
+  constexpr std::size_t kChunk = 8192;
+  std::vector<double> samples;
+  std::vector<double> times;
+  samples.reserve(kChunk);
+  times.reserve(kChunk);
+  std::uint64_t chunk_first = 0;
   std::uint64_t windows = 0;
   std::uint64_t gap_windows = 0;
-  while (reader.next(row)) {
-    const std::array<double, 1> sample{row[*column]};
-    if (!features.push(sample)) continue;
-    const dsp::DetailFeature& f = features.latest()[0];
-    io::append_number(text, row[reader.t_index()]);
+  auto write_window = [&](const dsp::WindowFeature& f) {
+    io::append_number(text, times[f.last_sample - chunk_first]);
     text += ',';
-    if (f.valid) {
-      io::append_number(text, f.rms);
+    if (f.feature.valid) {
+      io::append_number(text, f.feature.rms);
     } else {
       ++gap_windows;
     }
     text += '\n';
     ++windows;
+  };
+  bool more = true;
+  while (more) {
+    samples.clear();
+    times.clear();
+    while (samples.size() < kChunk && (more = reader.next(row))) {
+      samples.push_back(row[*column]);
+      times.push_back(row[reader.t_index()]);
+    }
+    features.push_block(samples, write_window);
+    chunk_first += samples.size();
     if (text.size() > (1u << 16)) {
       out << text;
       text.clear();

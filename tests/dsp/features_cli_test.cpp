@@ -59,10 +59,12 @@ std::vector<double> write_capture(const std::string& path, std::size_t rows,
   return p1;
 }
 
-TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
-  const std::string dir = test::scratch_dir("features_cli_gaps");
-  const std::vector<std::size_t> gaps = {450, 451, 1333};
-  const auto p1 = write_capture(dir + "/in.csv", 2000, gaps);
+// Runs `leakmon features` with the default parameters on a capture of `rows` rows with gaps and
+// checks every output row against the batch transform.
+void check_default_features(const std::string& name, std::size_t rows,
+                            const std::vector<std::size_t>& gaps, std::size_t expected_empty) {
+  const std::string dir = test::scratch_dir(name);
+  const auto p1 = write_capture(dir + "/in.csv", rows, gaps);
   const Outcome run = run_leakmon(
       "features --in " + dir + "/in.csv --channel p1 --out " + dir + "/features.csv", dir);
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -71,7 +73,7 @@ TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
   const auto lines = lines_of(dir + "/features.csv");
   ASSERT_FALSE(lines.empty());
   EXPECT_EQ(lines[0], "t,rms");
-  const std::size_t windows = (2000 - 400) / 20 + 1;
+  const std::size_t windows = (rows - 400) / 20 + 1;
   ASSERT_EQ(lines.size(), windows + 1);
   const auto expected = dsp::sliding_detail_features(p1, dsp::FeatureParams{});
   std::size_t empty = 0;
@@ -89,11 +91,23 @@ TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
       ++empty;
     } else {
       ASSERT_FALSE(rms.empty()) << "window " << w;
-      // The CLI streams; the batch sums the squares in another order: equal to 1e-12.
+      // The batch sums the squares in another order: equal to 1e-12.
       EXPECT_NEAR(std::stod(rms), expected[w].rms, 1e-12 * expected[w].rms) << "window " << w;
     }
   }
-  EXPECT_EQ(empty, 20u + 20u);  // 450-451 lie in windows 3..22, 1333 in windows 47..66
+  EXPECT_EQ(empty, expected_empty);
+}
+
+TEST(FeaturesCli, WritesOneRowPerWindowWithEmptyRmsExactlyAtGaps) {
+  // 450-451 lie in windows 3..22, 1333 in windows 47..66.
+  check_default_features("features_cli_gaps", 2000, {450, 451, 1333}, 20u + 20u);
+}
+
+// The command reads the capture in chunks of 8192 rows: windows that straddle a chunk boundary,
+// and gaps on either side of it, come out as in one piece.
+TEST(FeaturesCli, LongCaptureReadInChunksGivesEveryWindow) {
+  // 8191-8192 lie in windows 390..409, 16390 in windows 800..819.
+  check_default_features("features_cli_chunks", 20000, {8191, 8192, 16390}, 20u + 20u);
 }
 
 TEST(FeaturesCli, OptionsChooseWaveletLevelWindowStepAndMode) {
