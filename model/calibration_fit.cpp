@@ -19,6 +19,17 @@ constexpr double kScales[kCalibrationCount] = {1e8, 1e-7, 1.0, 100.0};
 constexpr double kLower[kCalibrationCount] = {3.5, 2.712, 6.0, 1.2};
 constexpr double kUpper[kCalibrationCount] = {10.5, 4.068, 14.0, 4.8};
 
+// An effect parameter beyond a bound is mirrored back into [lower, upper] rather than clamped:
+// a clamped parameter has no gradient, and a solver step that overshoots the bound (the first
+// steps are large) would leave it stuck there (a slow spool "found" at tau = 0.5 ms, say).
+double reflected(double value, double lower, double upper) {
+  const double width = upper - lower;
+  if (width <= 0.0) return lower;
+  double u = std::fmod(value - lower, 2.0 * width);
+  if (u < 0.0) u += 2.0 * width;
+  return lower + (u <= width ? u : 2.0 * width - u);
+}
+
 class SegmentFitProblem : public Eigen::DenseFunctor<double> {
  public:
   // Only the calibration parameters flagged in `free` are unknowns; the others stay at `start`.
@@ -69,7 +80,7 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
     for (std::size_t i = 0; i < candidate_->parameters.size(); ++i) {
       const auto& fp = candidate_->parameters[i];
       const double t = theta[first_effect_ + static_cast<int>(i)];
-      v.push_back(std::clamp(fp.initial + (t - 1.0) * fp.scale, fp.lower, fp.upper));
+      v.push_back(reflected(fp.initial + (t - 1.0) * fp.scale, fp.lower, fp.upper));
     }
     return v;
   }

@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "model/calibration_fit.hpp"
+#include "model/force_balance.hpp"
 #include "model/measured_record.hpp"
 #include "model/segment_predictor.hpp"
+#include "model/spectral_line.hpp"
 
 namespace leakmon::model {
 
@@ -26,9 +28,11 @@ struct RankedEffect {
   // Share of the nominal model's held-out squared error it removes: 1 - the geometric mean
   // over held-out segments of error after / error before.
   double score = 0.0;
-  double significance = 0.0;  // paired t statistic of the held-out per-segment improvement
-  bool plausible = false;     // fitted main parameter is a physical instance of the effect
-  bool refined = false;       // fitted with the calibration on all fitting segments
+  // The larger of the paired t statistic and Yuen's 20 %-trimmed paired t statistic of the
+  // held-out per-segment log improvement (diagnosis.cpp says why both).
+  double significance = 0.0;
+  bool plausible = false;  // fitted main parameter is a physical instance of the effect
+  bool refined = false;    // fitted with the calibration on all fitting segments
   std::vector<NamedValue> params;
   FitResult fit;
 };
@@ -44,8 +48,13 @@ struct DiagnosisSettings {
   // Naming a cause needs both: the extension removes at least this share of the calibrated
   // nominal model's held-out squared error, and it does so consistently over the held-out
   // segments (paired t statistic). docs/model-check.md explains the values.
-  double min_score = 0.02;
+  double min_score = 0.005;
   double min_significance = 2.5;
+  // A supply ripple is named on its own evidence, the held-out coherent line test of
+  // spectral_line.hpp: z >= 4.5 happens by chance once in about 300 000 clean captures.
+  double min_line_z = 4.5;
+  // Take m from the force balance (force_balance.hpp) instead of fitting it; b starts there.
+  bool use_force_balance = true;
 };
 
 struct Diagnosis {
@@ -58,8 +67,11 @@ struct Diagnosis {
   double nrmse_after = 0.0;           // held-out, model extended with the cause
   SegmentPlan plan;
   std::vector<Segment> fitting_used, held_out_used;
-  ModelParameters nominal, extended;  // the two models compared
-  std::optional<double> ripple_line_hz;
+  ModelParameters nominal, extended;        // the two models compared
+  std::optional<SpectralLine> ripple_line;  // the capture's most prominent line and its test
+  bool ripple_line_significant = false;
+  double min_line_z = 0.0;     // the threshold it was held to
+  ForceBalance force_balance;  // m (and a first b) from the measured force balance
 };
 
 Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settings = {});

@@ -15,7 +15,7 @@ struct FreeParameter {
   std::string name;  // MODEL.md's name; empty for a solver-only parameter (ripple phase)
   double scale;      // the solver works on value / scale, near 1
   double initial;    // starting value [SI]
-  double lower;      // values are clamped into [lower, upper] before they reach the model
+  double lower;      // values stay in [lower, upper] (the fit mirrors them back, apply clamps)
   double upper;
 };
 

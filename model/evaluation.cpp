@@ -39,17 +39,26 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
   out.estimate = main_estimate(d, c.main_parameter);
   out.nrmse_before = d.nrmse_before;
   out.nrmse_after = d.nrmse_after;
+  for (const auto& r : d.ranking) {
+    if (!r.plausible || !r.refined) continue;
+    out.leading = r.effect;
+    out.leading_score = r.score;
+    out.leading_significance = r.significance;
+    break;
+  }
+  if (d.ripple_line) out.line_z = d.ripple_line->held_out_z;
   return out;
 }
 
 std::string EvaluationSummary::csv() const {
   std::string out =
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
-      "nrmse_after,seconds\n";
+      "nrmse_after,seconds,leading,leading_score,leading_significance,line_z\n";
   for (const auto& c : cases) {
-    out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f}\n", c.seed, c.truth, c.named,
-                       c.main_parameter, c.true_value, c.estimate, c.nrmse_before, c.nrmse_after,
-                       c.seconds);
+    out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f}\n",
+                       c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate,
+                       c.nrmse_before, c.nrmse_after, c.seconds, c.leading, c.leading_score,
+                       c.leading_significance, c.line_z);
   }
   return out;
 }

@@ -19,6 +19,11 @@ struct CaseOutcome {
   double true_value = 0.0, estimate = 0.0;  // main parameter; estimate 0 when not named
   double nrmse_before = 0.0, nrmse_after = 0.0;
   double seconds = 0.0;  // diagnosis wall time
+  // The best plausible refined extension, named or not, and its held-out evidence: the
+  // margins to the naming thresholds (DiagnosisSettings) over many cases.
+  std::string leading;
+  double leading_score = 0.0, leading_significance = 0.0;
+  double line_z = 0.0;  // the supply-ripple line test's statistic
   bool named_correctly() const { return truth == named; }
   bool parameter_within(double tolerance) const;
 };

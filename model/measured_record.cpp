@@ -106,6 +106,7 @@ MeasuredRecord read_measured_record(const std::string& path, const RecordRequire
   require_columns(reader.columns(), path);
   const auto col = [&](std::string_view name) { return *reader.column_index(name); };
   const auto xref = reader.column_index("xref");
+  const auto ps = reader.column_index("ps");
   MeasuredRecord rec;
   rec.source = path;
   rec.controller = controller_from(reader.metadata());
@@ -118,6 +119,7 @@ MeasuredRecord read_measured_record(const std::string& path, const RecordRequire
     rec.p1.push_back(row[col("p1")]);
     rec.p2.push_back(row[col("p2")]);
     if (xref) rec.xref.push_back(row[*xref]);
+    if (ps) rec.ps.push_back(row[*ps]);
     origin.lines.push_back(reader.line_number());
   }
   return vet(std::move(rec), origin, req);
@@ -134,6 +136,7 @@ MeasuredRecord measured_record(const io::Capture& capture, const RecordRequireme
   rec.p1 = capture.column("p1");
   rec.p2 = capture.column("p2");
   if (capture.has("xref")) rec.xref = capture.column("xref");
+  if (capture.has("ps")) rec.ps = capture.column("ps");
   return vet(std::move(rec), RowOrigin{}, req);
 }
 

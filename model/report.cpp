@@ -82,6 +82,23 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
   out +=
       "Standard errors come from the Gauss-Newton covariance of the fit; residuals within a "
       "segment are correlated, so they are optimistic.\n\n";
+  if (d.force_balance.windows > 0) {
+    out += fmt::format(
+        "The measured force balance (docs/model-check.md) gives m = {:.4g} +- {:.2g} kg and "
+        "b = {:.4g} +- {:.2g} N s/m over {} windows{}.\n\n",
+        d.force_balance.m, d.force_balance.m_error, d.force_balance.b, d.force_balance.b_error,
+        d.force_balance.windows,
+        usable(d.force_balance) ? "; m is taken from it, b starts from it"
+                                : "; not usable here, so m is fitted");
+  }
+  if (d.ripple_line) {
+    out += fmt::format(
+        "Supply-ripple line test on {}: most prominent line at {:.4f} Hz, coherent second-half "
+        "statistic z = {:.2f} (N(0, 1) without a ripple; a ripple is a candidate from z >= "
+        "{:.1f}).\n\n",
+        d.ripple_line->from_supply_column ? "the supply pressure ps" : "p1 + p2",
+        d.ripple_line->frequency_hz, d.ripple_line->held_out_z, d.min_line_z);
+  }
   out +=
       "## Ranking of the effect library (held-out data)\n\n| effect | score | significance "
       "(t) | physical | parameters |\n|---|---|---|---|---|\n";

@@ -50,6 +50,11 @@ std::string diagnosis_json(const Diagnosis& d) {
   out +=
       fmt::format("  \"calibrated_errors\": {{\"beta\": {}, \"Kv\": {}, \"m\": {}, \"b\": {}}},\n",
                   number(e.beta), number(e.Kv), number(e.m), number(e.b));
+  if (d.ripple_line) {
+    out += fmt::format("  \"ripple_line\": {{\"f\": {}, \"z\": {}, \"signal\": \"{}\"}},\n",
+                       number(d.ripple_line->frequency_hz), number(d.ripple_line->held_out_z),
+                       d.ripple_line->from_supply_column ? "ps" : "p1+p2");
+  }
   out += "  \"ranking\": [\n";
   for (std::size_t i = 0; i < d.ranking.size(); ++i) {
     const auto& r = d.ranking[i];

@@ -1,7 +1,18 @@
-// A supply ripple is a spectral line (MODEL.md, last paragraph): a narrow peak standing far
-// above its neighbourhood in the pressure spectrum, unlike the broad hydraulic resonance that
-// the spool flow noise excites. Finding it first gives the ripple fit its frequency, which a
-// local solver could never find on its own.
+// A supply ripple is a spectral line (MODEL.md, last paragraph) locked to absolute time:
+// ps(t) = ps0 + dP sin(2 pi f t). It reaches the chambers through the valve's null leakage and
+// any open land, and it raises or lowers both chambers together, so it shows best in p1 + p2
+// (or in `ps` itself when the capture has it): the spool flow noise and the piston's motion
+// move p1 and p2 in opposite directions and largely cancel there. Finding the line first also
+// gives the ripple fit its frequency, which a local solver could never find on its own.
+//
+// The test is a held-out coherent demodulation. The first half of the capture alone picks the
+// frequency (the most prominent narrow peak) and the line's phase; the second half is then
+// demodulated at that frequency and projected on that phase. With the frequency and phase
+// fixed by data the second half never saw, the projection is, without a line, a zero-mean Gaussian
+// whose variance the held-out spectrum at neighbouring frequencies gives: `held_out_z` is a plain
+// z statistic, free of the selection bias of a peak searched on the same data. A real ripple
+// keeps its phase over the whole capture; oscillations that restart with every step (a
+// limit cycle, say) do not, and average out.
 #pragma once
 
 #include <optional>
@@ -12,19 +23,22 @@ namespace leakmon::model {
 
 struct SpectralLine {
   double frequency_hz = 0.0;
-  double prominence = 0.0;  // peak power over the median power around it
+  double prominence = 0.0;          // first half: peak power over the median power around it
+  double held_out_z = 0.0;          // coherent second-half statistic, N(0, 1) without a line
+  bool from_supply_column = false;  // tested on the capture's `ps`, not on p1 + p2
 };
 
 struct LineSearch {
   double low_hz = 15.0;
   double high_hz = 220.0;
-  double neighbourhood_hz = 3.0;
-  // Low on purpose: the ripple fit and its held-out score decide; this only skips spectra
-  // without any peak (a line of a few hundred kPa stands 25-100 times above its neighbours,
-  // the tallest noise peak of a clean capture 10-20 times).
-  double min_prominence = 8.0;
+  double neighbourhood_hz = 3.0;  // for the prominence's median
+  // Held-out noise level: the spectrum between these offsets on either side of the line.
+  double noise_offset_low_hz = 1.0;
+  double noise_offset_high_hz = 5.0;
+  double noise_step_hz = 0.1;
 };
 
+// The most prominent line of the first half and its test on the second half.
 std::optional<SpectralLine> find_spectral_line(const MeasuredRecord& record,
                                                const LineSearch& search = {});
 

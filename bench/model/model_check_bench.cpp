@@ -3,6 +3,8 @@
 #include <benchmark/benchmark.h>
 
 #include "model/diagnosis.hpp"
+#include "model/force_balance.hpp"
+#include "model/spectral_line.hpp"
 #include "model/synthetic_case.hpp"
 
 namespace {
@@ -37,6 +39,28 @@ void BM_FittingResiduals(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FittingResiduals)->Unit(benchmark::kMillisecond);
+
+// The supply-ripple line test on the 120 s capture: FFT of the first half, golden-section
+// refinement, the second half's neighbourhood (82 single DFT terms), whole-record refinement.
+void BM_SpectralLineTest120s(benchmark::State& state) {
+  const MeasuredRecord& record = capture_120s();
+  for (auto _ : state) {
+    auto line = find_spectral_line(record);
+    benchmark::DoNotOptimize(line);
+  }
+}
+BENCHMARK(BM_SpectralLineTest120s)->Unit(benchmark::kMillisecond);
+
+// The force-balance regression for m over the fitting half of the 120 s capture.
+void BM_ForceBalance120s(benchmark::State& state) {
+  const MeasuredRecord& record = capture_120s();
+  const auto fitting = split_record(record).fitting;
+  for (auto _ : state) {
+    ForceBalance fb = estimate_force_balance(record, fitting);
+    benchmark::DoNotOptimize(fb);
+  }
+}
+BENCHMARK(BM_ForceBalance120s)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

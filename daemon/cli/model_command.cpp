@@ -77,9 +77,9 @@ int run_evaluate_cases(int argc, char** argv) {
     const auto& c = summary.cases.back();
     fmt::print(
         "case {} seed {}: {} -> {} ({} true {:.4g} est {:.4g}) nrmse {:.4f} -> {:.4f} "
-        "{:.1f} s\n",
+        "{:.1f} s; leading {} score {:.4f} t {:.2f}; line z {:.2f}\n",
         i, seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
-        c.nrmse_after, c.seconds);
+        c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z);
     std::fflush(stdout);
   }
   const std::string dir = args.get("out");

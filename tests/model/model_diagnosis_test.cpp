@@ -4,11 +4,11 @@
 // The simulator makes the noisy "measured" capture and the model check must name the effect
 // and estimate its main parameter within 25 %.
 //
-// The workflow is a statistical decision: a weak effect drawn at the low end of its range (a
-// small supply ripple, little entrained air) can stay below the significance threshold and be
-// reported as `none`. So the per-run assertions are: the clean case is clean, no case is ever
-// given a wrong cause, and at least 8 of the 11 effects are named with their main parameter
-// within 25 %. The >= 95 % / >= 90 % targets are measured over many cases by
+// The workflow is a statistical decision: a weak effect drawn at the low end of its range
+// (little entrained air, a small supply ripple) can stay below the significance threshold and
+// be reported as `none`. So the per-run assertions are: the clean case is clean, no case is
+// ever given a wrong cause, and at least 10 of the 11 effects are named with their main
+// parameter within 25 %. The >= 95 % / >= 90 % targets are measured over many cases by
 // `leakmon model evaluate` (docs/model-check.md).
 #include <gtest/gtest.h>
 
@@ -76,8 +76,8 @@ TEST(HiddenEffect, EveryEffectOfTheLibraryIsFoundOrAtWorstMissed) {
     }
     if (o.named == effect && o.parameter_ok) ++found;
   }
-  EXPECT_GE(found, 8) << "named with the main parameter within 25 %: " << found << " of "
-                      << kEffects.size();
+  EXPECT_GE(found, 10) << "named with the main parameter within 25 %: " << found << " of "
+                       << kEffects.size();
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "model/actuator_model.hpp"
 #include "model/calibration_fit.hpp"
 #include "model/diagnosis.hpp"
+#include "model/force_balance.hpp"
 #include "model/measured_record.hpp"
 #include "model/synthetic_case.hpp"
 #include "sim/plant.hpp"
@@ -100,41 +101,79 @@ TEST(ActuatorModel, MatchesTheSimulatorsPlantForEveryEffect) {
   }
 }
 
-// Each run draws ten random cases. Kv is pinned down in every draw. beta, m and b trade off
-// against each other (together they set the hydraulic mode's frequency and damping), and in
-// about one draw in ten the fit slides along that valley: one of them lands outside its band
-// (m or b sometimes on its bound) or the held-out error rises past 0.03. So those are required
-// in at least seven of the ten draws rather than in every one; docs/model-check.md reports it.
+// m from the measured force balance (force_balance.hpp), on fresh random cases: clean ones,
+// and the effects that act on the piston or on one pressure reading (the regression's
+// friction, constant and pressure-change terms exist for them). A clean capture must give a
+// usable estimate; any estimate that calls itself usable must have m within 10 % (on these
+// 24 s captures strong Coulomb friction can make it unusable: diagnose() then fits m). b, only
+// a starting point for the calibration, must merely be in the right range.
+TEST(ForceBalance, RecoversMassAndDampingFromMeasuredSignals) {
+  const auto first_seed =
+      test::model_test_seed("ForceBalance.RecoversMassAndDampingFromMeasuredSignals");
+  const std::vector<std::string> effects = {"none",          "none",       "coulomb_friction",
+                                            "sensor_offset", "sensor_lag", "internal_leakage"};
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::uint64_t seed = first_seed + i;
+    const SyntheticCase c = draw_case(seed, effects[i], {24.0});
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const ForceBalance fb = estimate_force_balance(record, split_record(record).fitting);
+    const auto& truth = c.scenario.params;
+    std::printf("  %-16s seed %llu: m %.2f (true %.2f)  b %.0f (true %.0f)%s\n", effects[i].c_str(),
+                static_cast<unsigned long long>(seed), fb.m, truth.m, fb.b, truth.b,
+                usable(fb) ? "" : "  (not usable)");
+    if (effects[i] == "none") {
+      EXPECT_TRUE(usable(fb)) << "seed " << seed;
+    }
+    if (!usable(fb)) continue;
+    EXPECT_NEAR(fb.m, truth.m, 0.1 * truth.m) << effects[i] << " seed " << seed;
+    EXPECT_NEAR(fb.b, truth.b, 0.5 * truth.b) << effects[i] << " seed " << seed;
+  }
+}
+
+// Each run draws ten random cases: m from the force balance, beta, Kv and b fitted by the
+// simulation (the way diagnose() calibrates), on 24 s captures. Without the force balance
+// beta, m and b traded off along the hydraulic mode's valley (bands of 25 %, 20 % and 50 %
+// held in only about 9 draws of 10). With m measured the bands are tighter (beta 20 %, m 10 %,
+// b 40 %); on these short captures beta and b can still share the damping (seen: beta +17 %
+// with b +30 %), and now and then one held-out segment is mispredicted even with the right
+// parameters (held-out NRMSE 0.089 seen; docs/model-check.md), so nine of the ten draws must
+// be in the bands with a held-out NRMSE below 0.03, and Kv within 3 % in every draw.
 TEST(Calibration, RecoversPerturbedParametersFromNoisyData) {
   const auto first_seed =
       test::model_test_seed("Calibration.RecoversPerturbedParametersFromNoisyData");
   constexpr int kDraws = 10;
-  int good = 0;
+  int in_bands = 0;
   for (int i = 0; i < kDraws; ++i) {
     const std::uint64_t seed = first_seed + static_cast<std::uint64_t>(i);
     const SyntheticCase c = draw_case(seed, "none", {24.0});
     const MeasuredRecord record = measured_record(simulate_case(c));
     const SegmentPredictor predictor(record);
-    const auto segments = spread(split_record(record).fitting, 16);
-    const FitResult fit = fit_model(predictor, segments, nullptr, Calibration{});
+    const SegmentPlan plan = split_record(record);
+    const ForceBalance fb = estimate_force_balance(record, plan.fitting);
+    ASSERT_TRUE(usable(fb)) << "seed " << seed;
+    Calibration start;
+    start.m = fb.m;
+    start.b = fb.b;
+    FitSettings settings;
+    settings.free_calibration = {true, true, false, true};
+    const FitResult fit = fit_model(predictor, spread(plan.fitting, 16), nullptr, start, settings);
     const auto& truth = c.scenario.params;
     const auto& fitted = fit.parameters.calibration;
-    EXPECT_NEAR(fitted.Kv, truth.Kv, 0.03 * truth.Kv) << "seed " << seed;
-    const auto held_out = spread(split_record(record).held_out, 16);
-    const double nrmse = predictor.nrmse(fit.parameters, held_out);
-    const bool ok = std::abs(fitted.beta - truth.beta) <= 0.25 * truth.beta &&
-                    std::abs(fitted.m - truth.m) <= 0.2 * truth.m &&
-                    std::abs(fitted.b - truth.b) <= 0.5 * truth.b && nrmse < 0.03;
+    const double nrmse = predictor.nrmse(fit.parameters, spread(plan.held_out, 16));
+    const bool ok = std::abs(fitted.beta - truth.beta) <= 0.2 * truth.beta &&
+                    std::abs(fitted.m - truth.m) <= 0.1 * truth.m &&
+                    std::abs(fitted.b - truth.b) <= 0.4 * truth.b && nrmse < 0.03;
     std::printf(
-        "  seed %llu: beta %.3g (true %.3g)  m %.2f (true %.2f)  b %.0f (true %.0f)  "
-        "held-out nrmse %.4f %s\n",
-        static_cast<unsigned long long>(seed), fitted.beta, truth.beta, fitted.m, truth.m, fitted.b,
-        truth.b, nrmse, ok ? "" : "<- loose");
-    if (ok) ++good;
+        "  seed %llu: beta %.3g (true %.3g)  Kv %.3g (true %.3g)  m %.2f (true %.2f)  b %.0f "
+        "(true %.0f)  held-out nrmse %.4f%s\n",
+        static_cast<unsigned long long>(seed), fitted.beta, truth.beta, fitted.Kv, truth.Kv,
+        fitted.m, truth.m, fitted.b, truth.b, nrmse, ok ? "" : "  <- outside the bands");
+    EXPECT_NEAR(fitted.Kv, truth.Kv, 0.03 * truth.Kv) << "seed " << seed;
+    if (ok) ++in_bands;
   }
-  EXPECT_GE(good, 7)
-      << "beta within 25 %, m within 20 %, b within 50 % and held-out NRMSE < 0.03 in " << good
-      << " of " << kDraws << " draws";
+  EXPECT_GE(in_bands, 9) << "beta within 20 %, m within 10 %, b within 40 % and held-out NRMSE "
+                            "below 0.03 in "
+                         << in_bands << " of " << kDraws << " draws";
 }
 
 // The whole workflow on a short capture with a clear leak, cheap enough for the sanitizer
