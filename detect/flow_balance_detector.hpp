@@ -1,15 +1,19 @@
 // Model-aware leak detector for configurations that acquire the command u and position x as
 // well as both chamber pressures. At rest the valve must deliver what leaks across the piston:
-// Kv * q(u, p1, p2) = C_L (p1 - p2) + (null leakage, bias), with q the orifice law
-// (valve_flow.hpp). During learning the healthy relation q = a + s0 (p1 - p2) + g sign(p1 - p2)
-// is fitted (the slope s0 is the valve's own null leakage, the intercept a bias, the sign term a
-// spool overlap); afterwards the residual of blocks at rest is tested for an added slope
-// C_L / Kv with a CUSUM tuned for `design_leak`. The slope is what is identifiable: C_L = Kv
-// times the slope change, with Kv known only to +-`valve_coefficient_uncertainty`, which the
-// reported confidence interval includes. The controller's integral action or position error
-// does not matter: whatever hides the leak from x, the valve still has to deliver its flow.
+// Kv * o * R(p1, p2) = C_L (p1 - p2) + (null leakage), with o the spool opening and R the
+// orifice law's root factor (valve_flow.hpp) on the side the load makes the valve open to. So
+// the command at rest is u / u_max = offset + C (p1 - p2) / (Kv R): the test works in command
+// units. During learning the healthy at-rest command is fitted against the load (healthy_terms:
+// null leakage, valve bias, spool overlap and the curvature that spool noise around the overlap
+// edge gives it); afterwards the residual of blocks at rest is tested for an added slope
+// C_L / Kv on (p1 - p2) / R with a CUSUM tuned for `design_leak`. The slope is what is
+// identifiable: C_L = Kv times the slope change, with Kv known only to
+// +-`valve_coefficient_uncertainty`, which the reported confidence interval includes. The
+// controller's integral action or position error does not matter: whatever hides the leak from
+// x, the valve still has to be opened to feed it.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <string_view>
 #include <vector>
@@ -48,18 +52,36 @@ class FlowBalanceDetector final : public Detector {
   void reset() override;
 
  private:
-  struct RestHop {
-    double flow, load;  // normalised load flow and load pressure
-    std::size_t block;  // block number, to regroup the learning data
-  };
   struct Hop {
-    double flow = kMissing, load = kMissing, speed = kMissing;
+    double opening = kMissing;    // command minus what moves the piston [of full travel]
+    double load = kMissing;       // load pressure [of ps]
+    double root = kMissing;       // orifice root factor of the side the valve opens to at rest
+    double leak_term = kMissing;  // load / root: the opening a leak needs per unit C sqrt(ps)/Kv
+    double speed = kMissing;
     bool usable = false;  // all signals present and the command within the valve's range
   };
-  double expected_flow(double load) const;
+  struct RestHop {
+    Hop hop;
+    std::size_t block;  // block number, to regroup the learning data
+  };
+  static constexpr int kTerms = 6;
+  using Terms = Eigen::Matrix<double, kTerms, 1>;
+  Terms healthy_terms(const Hop& hop) const;
+  double expected_opening(const Hop& hop) const;
+  struct LoadRange {
+    double low = 0.0, high = 0.0, middle = 0.0;  // of the learning data's loads on one side
+  };
+  LoadRange learned_range(double side);  // uses scratch_
+  double robust_hop_sigma();             // uses scratch_
+  // False for a hop whose command falls far short of the healthy relation: the spool crossing
+  // its dead band while the piston stands still (no flow at all). A leak only ever needs more
+  // opening towards the loaded chamber, so leaving these out cannot hide one.
+  bool on_flow_branch(const Hop& hop) const;
+  static constexpr double kOffBranchSigmas = 6.0;
+  static constexpr double kMinRoot = 1e-3;  // a chamber at supply or tank: no flow to judge
   void accept(const Hop& hop, bool at_rest);
   void finish_learning();
-  void judge_block(double mean_residual, double mean_load);
+  void judge_block(double mean_residual, double mean_leak_term);
 
   FlowBalanceOptions options_;
   double hop_seconds_;
@@ -71,19 +93,24 @@ class FlowBalanceDetector final : public Detector {
   double previous_x_ = kMissing;
   Hop before_, pending_;          // the two latest hops; pending_ is judged when the next arrives
   std::vector<RestHop> learned_;  // reserved at construction
+  std::vector<double> scratch_;   // reserved at construction
   bool learned_model_ = false;
-  double coefficients_[3] = {0.0, 0.0, 0.0};  // flow = c0 + c1 load + c2 sign(load)
+  LoadRange positive_loads_, negative_loads_;
+  Terms coefficients_ = Terms::Zero();
+  double hop_sigma_ = kMissing;  // robust spread of one hop's residual
   double block_sigma_ = kMissing;
   // The current block.
   std::size_t block_hop_ = 0, block_rest_hops_ = 0;
-  double block_residual_sum_ = 0.0, block_load_sum_ = 0.0;
-  // The added slope by least squares of residual on load. While the CUSUM is positive, over
+  double block_residual_sum_ = 0.0, block_leak_term_sum_ = 0.0;
+  // The added slope by least squares of residual on leak term. While the CUSUM is positive, over
   // the blocks since it last left zero (its estimate of the change time), so that the size in
   // an alarm is not diluted by healthy data; otherwise exponentially weighted.
   struct SlopeSums {
     double rl = 0.0, ll = 0.0, ll_sq = 0.0;  // sum r*l, sum l^2 (weights w), sum w^2 l^2
   };
-  SlopeSums weighted_, since_change_;
+  // The block in which the CUSUM left zero holds the change itself, so it is partly healthy
+  // data: it sizes the leak only until a later block arrives.
+  SlopeSums weighted_, since_change_, change_block_;
   Cusum cusum_;
   Decision last_;
 };

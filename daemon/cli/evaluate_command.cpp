@@ -26,6 +26,8 @@
 #include "daemon/cli/args.hpp"
 #include "daemon/cli/subcommands.hpp"
 #include "daemon/replay.hpp"
+#include "detect/factory.hpp"
+#include "io/capture/capture.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 
@@ -76,8 +78,19 @@ struct Alarm {
   double leak_coefficient = NAN;
 };
 
+// The leak size and its 95 % interval that the flow balance reports when it first raises after
+// the onset. The daemon's alarm event carries the size but not the interval, so the detector
+// is run once more on the capture's hop means (the same Observation fields the worker fills).
+struct SizeCheck {
+  double t = NAN;
+  double leak_coefficient = NAN;
+  double half_width = NAN;
+  bool covers(double truth) const { return std::abs(leak_coefficient - truth) <= half_width; }
+};
+
 struct RunResult {
   RunSpec spec;
+  SizeCheck size_check;
   // [candidate][threshold] -> raise times and sizes
   std::vector<std::vector<std::vector<Alarm>>> alarms;
   double seconds = 0.0;
@@ -95,6 +108,8 @@ struct Settings {
   std::uint64_t seed = 1;
   int jobs = 2;
   std::vector<std::string> effects;  // MODEL.md effect names on every run (default parameters)
+  std::vector<int> keep_captures;    // run ids whose capture CSV is written into the output
+  std::filesystem::path out;
 };
 
 double uniform(std::mt19937_64& rng, double lo, double hi) {
@@ -151,14 +166,18 @@ std::vector<RunSpec> draw_runs(const Settings& settings) {
   return runs;
 }
 
+config::ConfigNode detector_options(const Settings& settings) {
+  return config::ConfigNode::load_string(
+      fmt::format("learn_seconds: {}\nsettle_seconds: {}\n", settings.learn_seconds,
+                  settings.settle_seconds),
+      "leakmon evaluate");
+}
+
 daemon::DaemonConfig evaluation_config(const io::Capture& capture, const Settings& settings) {
   daemon::DaemonConfig config = daemon::default_replay_config(capture);
   const daemon::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
-  const auto options =
-      config::ConfigNode::load_string(fmt::format("learn_seconds: {}\nsettle_seconds: {}\n",
-                                                  settings.learn_seconds, settings.settle_seconds),
-                                      "leakmon evaluate");
+  const auto options = detector_options(settings);
   const auto all = candidates();
   for (std::size_t c = 0; c < all.size(); ++c) {
     const Candidate& candidate = all[c];
@@ -180,12 +199,50 @@ daemon::DaemonConfig evaluation_config(const io::Capture& capture, const Setting
   return config;
 }
 
+SizeCheck check_size(const io::Capture& capture, const RunSpec& spec, const Settings& settings,
+                     const config::ConfigNode& options) {
+  constexpr std::size_t kStep = 20;  // the daemon's default hop
+  const double hop_seconds = static_cast<double>(kStep) / capture.sample_rate_hz();
+  const auto detector =
+      detect::make_detector("flow_balance", {true, true, true, true}, hop_seconds, &options);
+  const auto& t = capture.column("t");
+  const auto &u = capture.column("u"), &x = capture.column("x");
+  const auto &p1 = capture.column("p1"), &p2 = capture.column("p2");
+  auto mean = [](const std::vector<double>& v, std::size_t from, std::size_t to) {
+    double sum = 0.0;
+    for (std::size_t i = from; i < to; ++i) sum += v[i];
+    return sum / static_cast<double>(to - from);
+  };
+  SizeCheck check;
+  for (std::size_t end = kStep; end <= capture.rows(); end += kStep) {
+    detect::Observation o;
+    o.t = t[end - 1];
+    o.u = mean(u, end - kStep, end);
+    o.x = mean(x, end - kStep, end);
+    o.p1 = mean(p1, end - kStep, end);
+    o.p2 = mean(p2, end - kStep, end);
+    const detect::Decision decision = detector->update(o);
+    if (o.t < spec.onset || !(decision.score >= detector->raise_threshold())) continue;
+    if (o.t - spec.onset > settings.detect_within) break;
+    check = {o.t, decision.leak_coefficient, decision.leak_coefficient_ci};
+    break;
+  }
+  return check;
+}
+
 RunResult evaluate_run(const RunSpec& spec, const Settings& settings) {
   RunResult result;
   result.spec = spec;
   const io::Capture capture = sim::simulate(spec.scenario);
+  if (std::find(settings.keep_captures.begin(), settings.keep_captures.end(), spec.id) !=
+      settings.keep_captures.end()) {
+    io::write_capture((settings.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
+  }
   const daemon::ReplayResult replay =
       daemon::replay_capture(capture, evaluation_config(capture, settings));
+  if (spec.leak > 0.0) {
+    result.size_check = check_size(capture, spec, settings, detector_options(settings));
+  }
   const auto all = candidates();
   result.alarms.resize(all.size());
   std::map<std::string, std::pair<std::size_t, std::size_t>> by_name;
@@ -274,7 +331,7 @@ std::vector<std::string> split(const std::string& text) {
   return items;
 }
 
-std::vector<double> parse_list(const std::string& text) {
+std::vector<double> parse_list(const std::string& option, const std::string& text) {
   std::vector<double> values;
   std::stringstream in(text);
   std::string item;
@@ -282,7 +339,7 @@ std::vector<double> parse_list(const std::string& text) {
     try {
       values.push_back(std::stod(item));
     } catch (const std::exception&) {
-      throw UsageError(fmt::format("option '--leaks': '{}' is not a number", item));
+      throw UsageError(fmt::format("option '--{}': '{}' is not a number", option, item));
     }
   }
   return values;
@@ -307,6 +364,8 @@ int run_evaluate(int argc, char** argv) {
       .option("jobs", "N", "parallel runs", "2")
       .option("effects", "LIST",
               "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
+      .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
+              "")
       .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
       .option("plot-script", "PATH", "the plotting script", "docs/tools/detection_plots.py");
   if (!args.parse(argc, argv)) return 0;
@@ -315,7 +374,7 @@ int run_evaluate(int argc, char** argv) {
   settings.healthy_runs = static_cast<int>(args.get_int("healthy-runs"));
   settings.healthy_seconds = args.get_double("healthy-seconds");
   settings.runs_per_leak = static_cast<int>(args.get_int("runs-per-leak"));
-  settings.leak_sizes = parse_list(args.get("leaks"));
+  settings.leak_sizes = parse_list("leaks", args.get("leaks"));
   settings.learn_seconds = args.get_double("learn-seconds");
   settings.after_onset_seconds = args.get_double("after-onset");
   settings.seed = static_cast<std::uint64_t>(args.get_int("seed"));
@@ -336,7 +395,11 @@ int run_evaluate(int argc, char** argv) {
     throw UsageError(
         "need --learn-seconds >= 1, --healthy-seconds >= learn + 10, --after-onset >= 60");
   }
+  for (double id : parse_list("keep-captures", args.get("keep-captures"))) {
+    settings.keep_captures.push_back(static_cast<int>(id));
+  }
   const std::filesystem::path out = args.get("out");
+  settings.out = out;
   std::filesystem::create_directories(out);
 
   const std::vector<RunSpec> runs = draw_runs(settings);
@@ -394,7 +457,12 @@ int run_evaluate(int argc, char** argv) {
         }
         f.print("]");
       }
-      f.print("}}}}{}\n", i + 1 < results.size() ? "," : "");
+      const SizeCheck& size = r.size_check;
+      f.print(
+          "}}, \"size_at_raise\": {{\"t\": {}, \"leak_coefficient\": {}, "
+          "\"half_width_95\": {}}}}}{}\n",
+          json_number(size.t), json_number(size.leak_coefficient), json_number(size.half_width),
+          i + 1 < results.size() ? "," : "");
     }
     f.print("]\n");
   }
@@ -404,6 +472,8 @@ int run_evaluate(int argc, char** argv) {
   auto f_json = fmt::output_file((out / "summary.json").string());
   auto f_tsv = fmt::output_file((out / "summary.tsv").string());
   auto f_md = fmt::output_file((out / "summary.md").string());
+  auto f_tsv_coverage = fmt::output_file((out / "size_coverage.tsv").string());
+  f_tsv_coverage.print("controller\tleak\traised\tcovered\tmedian_relative_half_width\n");
   f_tsv.print(
       "detector\tcontroller\tleak\tthreshold\tdesign\tfa_per_hour\thealthy_hours\t"
       "detected\tleak_runs\tdetection_rate\tmedian_delay\tmedian_abs_size_error\n");
@@ -476,8 +546,36 @@ int run_evaluate(int argc, char** argv) {
   f_json.print("  ]\n}}\n");
   f_json.close();
   f_tsv.close();
+  // How often the flow balance's 95 % interval at its first raise covers the true C_L.
+  f_md.print(
+      "\n| controller | C_L [m^3/(s Pa)] | raised within {:.0f} s | interval covers truth | "
+      "median half-width / C_L |\n|---|---|---|---|---|\n",
+      settings.detect_within);
+  for (const auto& controller : controllers) {
+    for (double size : settings.leak_sizes) {
+      int raised = 0, covered = 0;
+      std::vector<double> widths;
+      for (const auto& r : results) {
+        if (r.spec.leak != size || std::isnan(r.size_check.leak_coefficient)) continue;
+        if (controller != "all" && sim::to_string(r.spec.scenario.controller) != controller) {
+          continue;
+        }
+        ++raised;
+        covered += r.size_check.covers(size) ? 1 : 0;
+        widths.push_back(r.size_check.half_width / size);
+      }
+      std::sort(widths.begin(), widths.end());
+      f_md.print("| {} | {:.2g} | {} | {}/{} | {} |\n", controller, size, raised, covered, raised,
+                 widths.empty() ? std::string("-")
+                                : fmt::format("{:.0f} %", 100.0 * widths[widths.size() / 2]));
+      f_tsv_coverage.print("{}\t{:g}\t{}\t{}\t{:.4g}\n", controller, size, raised, covered,
+                           widths.empty() ? NAN : widths[widths.size() / 2]);
+    }
+  }
   f_md.close();
-  fmt::print("wrote {}/runs.json, summary.json, summary.tsv, summary.md\n", out.string());
+  f_tsv_coverage.close();
+  fmt::print("wrote {}/runs.json, summary.json, summary.tsv, summary.md, size_coverage.tsv\n",
+             out.string());
 
   if (args.flag_set("plots")) {
     const std::string command =

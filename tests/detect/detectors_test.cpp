@@ -139,6 +139,26 @@ TEST(FlowBalanceDetector, QuietOnAHealthyRigWithStrongNullLeak) {
   EXPECT_NEAR(r.last.leak_coefficient, 0.0, r.last.leak_coefficient_ci + 0.1e-12);
 }
 
+// MODEL.md's valve bias and overlap present from the start: the learned healthy relation takes
+// up the offset and dead band (both scale with the orifice root factor), and hops with the
+// spool inside the dead band are left out rather than read as missing flow.
+TEST(FlowBalanceDetector, LearnsValveBiasAndOverlapAndStillFindsASmallLeak) {
+  for (const double bias : {0.1, -0.3}) {
+    auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+    test::SyntheticRig rig;
+    rig.command_offset = bias;
+    rig.overlap = 0.02;
+    rig.crossing_hops = 5;
+    rig.onset = 900.0;
+    rig.leak = 5e-13;
+    const RunResult r = run(*detector, rig, 1000.0);
+    EXPECT_LT(r.max_healthy_score, detector->raise_threshold()) << bias;
+    EXPECT_GT(r.first_raise, rig.onset) << bias;
+    EXPECT_LT(r.first_raise, rig.onset + 30.0) << bias;
+    EXPECT_NEAR(r.last.leak_coefficient, 5e-13, 0.2e-12) << bias;
+  }
+}
+
 TEST(FusedDetector, RaisesOnLeakAndReportsSize) {
   auto detector = make_detector("fused", kAll, 0.04, nullptr);
   test::SyntheticRig rig;

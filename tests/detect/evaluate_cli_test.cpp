@@ -64,10 +64,12 @@ TEST(EvaluateCommand, SmallFixedSeedEvaluation) {
   const std::string dir = test::scratch_dir("evaluate_cli");
   ASSERT_EQ(run_leakmon("evaluate --out " + dir +
                             " --healthy-runs 1 --healthy-seconds 150 --runs-per-leak 2"
-                            " --leaks 1e-12 --learn-seconds 30 --after-onset 60 --seed 3",
+                            " --leaks 1e-12 --learn-seconds 30 --after-onset 60 --seed 3"
+                            " --keep-captures 1",
                         dir),
             0);
-  for (const char* file : {"runs.json", "summary.json", "summary.tsv", "summary.md"}) {
+  for (const char* file : {"runs.json", "summary.json", "summary.tsv", "summary.md",
+                           "size_coverage.tsv", "run-1.csv"}) {
     EXPECT_GT(std::filesystem::file_size(dir + "/" + file), 100u) << file;
   }
   const std::vector<Row> rows = read_tsv(dir + "/summary.tsv");
@@ -83,6 +85,18 @@ TEST(EvaluateCommand, SmallFixedSeedEvaluation) {
   EXPECT_EQ(std::stod(leak->at("fa_per_hour")), 0.0);
   // The raising alarm carries the leak size; within a factor of two of the truth.
   EXPECT_LT(std::stod(leak->at("median_abs_size_error")), 0.5);
+
+  // The flow balance's 95 % interval at its first raise: both runs raised; at least one of the
+  // two intervals covers the true size (a 95 % interval misses both with probability 0.0025).
+  const std::vector<Row> coverage = read_tsv(dir + "/size_coverage.tsv");
+  const Row* all_runs = nullptr;
+  for (const auto& row : coverage) {
+    if (row.at("controller") == "all" && row.at("leak") == "1e-12") all_runs = &row;
+  }
+  ASSERT_NE(all_runs, nullptr);
+  EXPECT_EQ(all_runs->at("raised"), "2");
+  EXPECT_GE(std::stoi(all_runs->at("covered")), 1);
+  EXPECT_LT(std::stod(all_runs->at("median_relative_half_width")), 0.5);
 
   // Lower thresholds never detect less (the ROC sweep is consistent).
   for (const char* detector : {"index_cusum", "flow_balance", "fused", "default"}) {
@@ -101,6 +115,7 @@ TEST(EvaluateCommandOptions, RejectsBadOptions) {
   const std::string dir = test::scratch_dir("evaluate_cli_options");
   EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --jobs 0", dir), 2);
   EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --leaks 1e-12,abc", dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --keep-captures one", dir), 2);
   EXPECT_EQ(run_leakmon("evaluate", dir), 2);  // --out is required
 }
 

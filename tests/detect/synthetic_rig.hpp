@@ -21,12 +21,19 @@ struct SyntheticRig {
   double index_drop = 0.0;    // relative index drop once the leak is on
   double index_noise = 0.15;  // log-index scatter per independent window
   double kv = 3.39e-7;
+  // MODEL.md's valve_bias (the valve sees u + command_offset) and valve_overlap (a dead band of
+  // `overlap` of full travel). With overlap, the first `crossing_hops` of a hold on the other
+  // side hold the spool inside the dead band (no flow) while the piston stands still.
+  double command_offset = 0.0;  // [V]
+  double overlap = 0.0;
+  int crossing_hops = 0;
   double spring = 80e3, area = 6.334e-4;
   detect::ValveGeometry valve;
   std::mt19937_64 rng{1};
 
   double t = 0.0;
   double hold_left = 0.0, x = 0.0, target = 0.0;
+  int crossing_left = 0;
   double window_level = 0.0;  // the log-index's slowly varying part (one window memory)
 
   detect::Observation next() {
@@ -52,7 +59,12 @@ struct SyntheticRig {
     const double flow = (leak_now + null_leak) * dp + area * (x - previous_x) / hop;
     const double per_opening = std::abs(detect::load_flow_per_kv(
         valve, std::copysign(valve.command_full_scale, flow), p_mid + dp / 2, p_mid - dp / 2));
-    o.u = valve.command_full_scale * flow / (kv * per_opening) + 1e-3 * normal(rng);
+    const double opening = flow / (kv * per_opening);
+    const bool arrived_across = x == target && previous_x != x && previous_x * x < 0.0;
+    if (arrived_across) crossing_left = crossing_hops;
+    const double spool = crossing_left > 0 ? 0.0 : opening + std::copysign(overlap, opening);
+    if (crossing_left > 0) --crossing_left;
+    o.u = valve.command_full_scale * spool - command_offset + 1e-3 * normal(rng);
     // Index: load-dependent level, AR(1) with about one window of memory, drop after onset.
     window_level = 0.95 * window_level + std::sqrt(1 - 0.95 * 0.95) * index_noise * normal(rng);
     const double load = dp / valve.supply_pressure;
