@@ -167,6 +167,11 @@ Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
     event.leak_lpm_per_mpa = c * kLpmPerM3s * 1e6;
     event.load_pressure = last_load_pressure_;
     event.leak_lpm = c * last_load_pressure_ * kLpmPerM3s;
+    const double half_width = last_decision_.leak_coefficient_ci;
+    if (std::isfinite(half_width)) {
+      event.leak_lpm_per_mpa_ci95 = half_width * kLpmPerM3s * 1e6;
+      event.leak_lpm_ci95 = half_width * last_load_pressure_ * kLpmPerM3s;
+    }
   }
   return event;
 }

@@ -62,6 +62,9 @@ struct Event {
   double leak_coefficient = kNoValue;
   double leak_lpm_per_mpa = kNoValue;
   double leak_lpm = kNoValue;
+  // 95 % half-widths of the two sizes above (statistics and the valve-gain uncertainty).
+  double leak_lpm_per_mpa_ci95 = kNoValue;
+  double leak_lpm_ci95 = kNoValue;
   double load_pressure = kNoValue;  // |p1 - p2| [Pa] over the deciding hop
   std::string message;              // human-readable detail (driver error text, counts...)
   double unix_time = kNoValue;  // wall-clock time of publication [s since 1970], set by the worker

@@ -91,6 +91,8 @@ std::string to_json_line(const Event& event) {
   json.number("leak_coefficient", event.leak_coefficient);
   json.number("leak_lpm_per_mpa", event.leak_lpm_per_mpa);
   json.number("leak_lpm", event.leak_lpm);
+  json.number("leak_lpm_per_mpa_ci95", event.leak_lpm_per_mpa_ci95);
+  json.number("leak_lpm_ci95", event.leak_lpm_ci95);
   json.number("load_pressure_mpa", event.load_pressure / 1e6);
   if (is_alarm(event.kind)) json.boolean("latched", event.latched);
   json.string("message", event.message);

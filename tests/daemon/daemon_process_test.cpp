@@ -136,6 +136,11 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
     if (line.find("\"event\": \"alarm_raised\"") == std::string::npos) continue;
     EXPECT_GT(number_after(line, "\"t\": "), kOnset) << line;
     EXPECT_NE(line.find("\"leak_lpm_per_mpa\""), std::string::npos) << line;
+    // The interval is a positive half-width smaller than the estimate (a sized leak).
+    EXPECT_GT(number_after(line, "\"leak_lpm_per_mpa_ci95\": "), 0.0) << line;
+    EXPECT_LT(number_after(line, "\"leak_lpm_per_mpa_ci95\": "),
+              number_after(line, "\"leak_lpm_per_mpa\": "))
+        << line;
   }
 
   // Every acquired sample was processed and recorded, and the recording replays to the same
