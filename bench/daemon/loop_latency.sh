@@ -12,9 +12,9 @@ out=$(mktemp -d)
 period_us=2000
 priority=80
 
-cyclic() {  # -> "min avg p99 max" in us
+cyclic() {  # -> "min avg p99 max" in us, then the count of wake-ups >= one period late
   cyclictest -q -m -p "$priority" -i "$period_us" -D "${duration}s" -h 20000 >"$out/cyclic.txt" 2>&1
-  /usr/bin/python3 - "$out/cyclic.txt" <<'PY'
+  /usr/bin/python3 - "$out/cyclic.txt" "$period_us" <<'PY'
 import sys
 hist = {}; mn = av = mx = None; overflow = 0
 for line in open(sys.argv[1]):
@@ -28,7 +28,9 @@ total = sum(hist.values()) + overflow; seen = 0; p99 = mx
 for us in sorted(hist):
     seen += hist[us]
     if seen >= 0.99 * total: p99 = us; break
-print(mn, av, p99, mx)
+# Wake-ups a whole period late: what would be overruns for a loop that did no work at all.
+late = sum(n for us, n in hist.items() if us >= int(sys.argv[2])) + overflow
+print(mn, av, p99, mx, late)
 PY
 }
 
@@ -47,12 +49,12 @@ rss() {  # daemon RSS (kB) with 8 channels after half the run
 
 report() {  # label
   echo "### $1 ($(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) CPUs)"
-  read -r cmin cavg cp99 cmax < <(cyclic)
+  read -r cmin cavg cp99 cmax clate < <(cyclic)
   declare -A l
   while read -r k v; do l[$k]=$v; done < <(loop)
   echo "| | min us | avg us | p99 us | max us | overruns | missed | ring drops |"
   echo "|---|---|---|---|---|---|---|---|"
-  echo "| cyclictest -i $period_us -p $priority, ${duration} s | $cmin | $cavg | $cp99 | $cmax | | | |"
+  echo "| cyclictest -i $period_us -p $priority, ${duration} s | $cmin | $cavg | $cp99 | $cmax | $clate wake-ups >= ${period_us} us late | | |"
   echo "| leakmon loop (sim, ${l[channels]} ch, cpu_wakeup_latency_us ${l[cpu_wakeup_request]}), ${duration} s | ${l[wakeup_min_us]} | ${l[wakeup_avg_us]} | ${l[wakeup_p99_us]} | ${l[wakeup_max_us]} | ${l[overruns]} | ${l[missed_cycles]} | ${l[ring_drops]} |"
   echo
   echo "sample-to-decision (alarm event path): p50 ${l[decision_p50_us]} us, p99 ${l[decision_p99_us]} us, max ${l[decision_max_us]} us; SCHED_FIFO ${l[sched_fifo]}, mlockall ${l[mlockall]}"
