@@ -93,9 +93,10 @@ struct Peak {
   double prominence = 0.0;
 };
 
-// Most prominent local maximum of the power spectrum in the search band.
-std::optional<Peak> most_prominent_peak(const std::vector<double>& s, double dt,
-                                        const LineSearch& search) {
+// The `count` most prominent local maxima of the power spectrum in the search band, most
+// prominent first, each refined to a fraction of a bin.
+std::vector<Peak> most_prominent_peaks(const std::vector<double>& s, double dt,
+                                       const LineSearch& search, std::size_t count) {
   std::size_t n = 1;
   while (n < s.size()) n *= 2;
   std::vector<double> padded(s);
@@ -111,7 +112,7 @@ std::optional<Peak> most_prominent_peak(const std::vector<double>& s, double dt,
                                    power.size() - 2);
   };
   const std::size_t half = std::max<std::size_t>(8, bin(search.neighbourhood_hz));
-  std::optional<Peak> best;
+  std::vector<Peak> peaks;
   std::vector<double> around;
   for (std::size_t k = bin(search.low_hz); k <= bin(search.high_hz); ++k) {
     if (power[k] < power[k - 1] || power[k] < power[k + 1]) continue;
@@ -119,14 +120,42 @@ std::optional<Peak> most_prominent_peak(const std::vector<double>& s, double dt,
                   power.begin() + static_cast<std::ptrdiff_t>(std::min(power.size(), k + half)));
     std::nth_element(around.begin(),
                      around.begin() + static_cast<std::ptrdiff_t>(around.size() / 2), around.end());
-    const double prominence = power[k] / std::max(around[around.size() / 2], 1e-300);
-    if (!best || prominence > best->prominence) {
-      best = Peak{static_cast<double>(k) * df, prominence};
+    peaks.push_back(
+        {static_cast<double>(k) * df, power[k] / std::max(around[around.size() / 2], 1e-300)});
+  }
+  const auto more_prominent = [](const Peak& a, const Peak& b) {
+    return a.prominence > b.prominence;
+  };
+  if (peaks.size() > count) {
+    std::partial_sort(peaks.begin(), peaks.begin() + static_cast<std::ptrdiff_t>(count),
+                      peaks.end(), more_prominent);
+    peaks.resize(count);
+  } else {
+    std::sort(peaks.begin(), peaks.end(), more_prominent);
+  }
+  for (Peak& peak : peaks) peak.frequency_hz = strongest_near(s, dt, peak.frequency_hz, df);
+  return peaks;
+}
+
+// The second half's coherent statistic at f, on the first half's phase there (see the header).
+double held_out_z(const std::vector<double>& first, const std::vector<double>& second, double f,
+                  double dt, const LineSearch& search) {
+  const std::complex<double> phase = amplitude_at(first, f, dt);
+  const std::complex<double> tested = amplitude_at(second, f, dt);
+  // Noise level from neighbouring frequencies, median / ln 2: the mean of an exponentially
+  // distributed power, robust to another line nearby.
+  std::vector<double> noise;
+  for (double offset = search.noise_offset_low_hz; offset <= search.noise_offset_high_hz + 1e-9;
+       offset += search.noise_step_hz) {
+    for (double sign : {-1.0, 1.0}) {
+      noise.push_back(std::norm(amplitude_at(second, f + sign * offset, dt)));
     }
   }
-  if (!best) return std::nullopt;
-  best->frequency_hz = strongest_near(s, dt, best->frequency_hz, df);
-  return best;
+  std::nth_element(noise.begin(), noise.begin() + static_cast<std::ptrdiff_t>(noise.size() / 2),
+                   noise.end());
+  const double noise_power = std::max(noise[noise.size() / 2] / std::numbers::ln2, 1e-300);
+  const double projection = (tested * std::conj(phase)).real() / std::max(std::abs(phase), 1e-300);
+  return projection / std::sqrt(noise_power / 2.0);
 }
 
 }  // namespace
@@ -141,28 +170,17 @@ std::optional<SpectralLine> find_spectral_line(const MeasuredRecord& record,
   // 1 / (block period) around the line, nearly as tall as the line itself.
   const std::vector<double> first = tapered(signal, 1, n / 2);
   const std::vector<double> second = tapered(signal, n / 2, n);
-  const auto peak = most_prominent_peak(first, record.dt, search);
-  if (!peak) return std::nullopt;
-  line.prominence = peak->prominence;
-
-  // The first half's phase, the second half's amplitude projected on it, and the second half's
-  // noise level from neighbouring frequencies (median / ln 2: the mean of an exponentially
-  // distributed power, robust to another line nearby).
-  const double f = peak->frequency_hz;
-  const std::complex<double> phase = amplitude_at(first, f, record.dt);
-  const std::complex<double> tested = amplitude_at(second, f, record.dt);
-  std::vector<double> noise;
-  for (double offset = search.noise_offset_low_hz; offset <= search.noise_offset_high_hz + 1e-9;
-       offset += search.noise_step_hz) {
-    for (double sign : {-1.0, 1.0}) {
-      noise.push_back(std::norm(amplitude_at(second, f + sign * offset, record.dt)));
+  const std::vector<Peak> peaks = most_prominent_peaks(first, record.dt, search, search.candidates);
+  if (peaks.empty()) return std::nullopt;
+  double f = 0.0;
+  for (std::size_t i = 0; i < peaks.size(); ++i) {
+    const double z = held_out_z(first, second, peaks[i].frequency_hz, record.dt, search);
+    if (i == 0 || z > line.held_out_z) {
+      line.held_out_z = z;
+      line.prominence = peaks[i].prominence;
+      f = peaks[i].frequency_hz;
     }
   }
-  std::nth_element(noise.begin(), noise.begin() + static_cast<std::ptrdiff_t>(noise.size() / 2),
-                   noise.end());
-  const double noise_power = std::max(noise[noise.size() / 2] / std::numbers::ln2, 1e-300);
-  const double projection = (tested * std::conj(phase)).real() / std::max(std::abs(phase), 1e-300);
-  line.held_out_z = projection / std::sqrt(noise_power / 2.0);
 
   // The frequency the ripple fit starts from: refined on the whole record (fitting, not
   // testing), where the line is narrowest.

@@ -7,9 +7,10 @@
 // The workflow is a statistical decision: a weak effect drawn at the low end of its range
 // (little entrained air, a small supply ripple) can stay below the significance threshold and
 // be reported as `none`. So the per-run assertions are: the clean case is clean, no case is
-// ever given a wrong cause, and at least 10 of the 11 effects are named with their main
-// parameter within 25 %. The >= 95 % / >= 90 % targets are measured over many cases by
-// `leakmon model evaluate` (docs/model-check.md).
+// ever given a wrong cause, and at least 9 of the 11 effects are named with their main
+// parameter within 25 % (`leakmon model evaluate` found 118 of 120: with that rate a run
+// misses two of eleven about once in 70, three about once in 1200). The >= 95 % / >= 90 %
+// targets are measured over many cases by `leakmon model evaluate` (docs/model-check.md).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,8 +77,8 @@ TEST(HiddenEffect, EveryEffectOfTheLibraryIsFoundOrAtWorstMissed) {
     }
     if (o.named == effect && o.parameter_ok) ++found;
   }
-  EXPECT_GE(found, 10) << "named with the main parameter within 25 %: " << found << " of "
-                       << kEffects.size();
+  EXPECT_GE(found, 9) << "named with the main parameter within 25 %: " << found << " of "
+                      << kEffects.size();
 }
 
 }  // namespace
