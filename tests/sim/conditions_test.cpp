@@ -180,11 +180,20 @@ TEST(Conditions, StepStaysAllocationFreeWithDriftingConditions) {
   s.conditions.temperature = t;
   s.conditions.supply = {{1.0, 14e6, 0.5}, {3.0, 18e6, 0.0}};
   s.effects.external_leakage->onset_s = 2.0;
+  s.record.ps = s.record.temp = true;
+  SensorFault spikes{SensorFault::Kind::spikes, SensorChannel::ps, 0.5, 3.0};
+  spikes.rate_per_min = 600.0;
+  SensorFault gap{SensorFault::Kind::dropout, SensorChannel::x, 1.0, 1.0};
+  gap.gap = true;
+  s.faults = {SensorFault{SensorFault::Kind::frozen, SensorChannel::p1, 1.0, 2.0}, spikes, gap,
+              SensorFault{SensorFault::Kind::saturated, SensorChannel::temp, 2.0, 1.0}};
   Rig rig(s);
   double checksum = 0.0;
   {
     test::AllocationScope scope;
     for (std::uint64_t k = 0; k < s.samples(); ++k) checksum += rig.step().p1;
+    rig.reset();
+    for (std::uint64_t k = 0; k < 500; ++k) checksum += rig.step().ps;
     EXPECT_EQ(scope.count(), 0u);
   }
   EXPECT_TRUE(std::isfinite(checksum));
