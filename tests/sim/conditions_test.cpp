@@ -4,6 +4,7 @@
 // external leak's onset, and the allocation-free step with every condition active.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -197,6 +198,42 @@ TEST(Conditions, StepStaysAllocationFreeWithDriftingConditions) {
     EXPECT_EQ(scope.count(), 0u);
   }
   EXPECT_TRUE(std::isfinite(checksum));
+}
+
+// The automatic step is sized for the coldest oil of the profile: halving it moves the
+// trajectories by less than 5 % of a sensor LSB through a warm-up from 10 degC with supply
+// changes, as on the stationary presets (numerics_test).
+TEST(Conditions, StepHalvingHoldsThroughAColdWarmUpAndSupplyChanges) {
+  Scenario s = preset("paper-fig10", 8);
+  s.duration_s = 20.0;
+  s.sensors.enabled = false;
+  TemperatureProfile cold;
+  cold.kind = TemperatureProfile::Kind::warm_up_cooler;
+  cold.T0 = 10.0;
+  cold.T_work = 55.0;
+  cold.tau_s = 6.0;
+  cold.period_s = 3.0;
+  cold.amplitude = 3.0;
+  cold.cooler_start_s = 12.0;
+  s.conditions.temperature = cold;
+  s.conditions.supply = {{5.0, 13e6, 1.0}, {14.0, 19e6, 0.0}};
+  Scenario coarse = s, fine = s;
+  coarse.integration_step_s = integration_step(s);
+  fine.integration_step_s = coarse.integration_step_s / 2.0;
+  const auto a = testing::run(coarse);
+  const auto b = testing::run(fine);
+  double dp = 0.0, dx = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (std::getenv("DIAG") && std::abs(a[k].p1_true - b[k].p1_true) > 100)
+      std::printf("t %g d %g\n", a[k].t, a[k].p1_true - b[k].p1_true);
+    dp = std::max(
+        {dp, std::abs(a[k].p1_true - b[k].p1_true), std::abs(a[k].p2_true - b[k].p2_true)});
+    dx = std::max(dx, std::abs(a[k].x_true - b[k].x_true));
+  }
+  std::printf("step %g s: halving moves p by %.1f Pa, x by %.3g m\n", coarse.integration_step_s, dp,
+              dx);
+  EXPECT_LT(dp, 0.05 * s.sensors.pressure_lsb());
+  EXPECT_LT(dx, 0.05 * s.sensors.position_resolution);
 }
 
 TEST(TemperatureProfiles, FollowTheirDefinitions) {
