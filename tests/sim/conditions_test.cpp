@@ -137,6 +137,22 @@ TEST(Conditions, WarmUpRaisesTheNullLeakageAsTheViscosityRatioPredicts) {
   EXPECT_NEAR(run.back().temp_true, warm.at(59.998), 1e-9);
 }
 
+TEST(Conditions, LeakSizeIsStatedAtFortyDegrees) {
+  // q_int = r(T) C_L (p1 - p2): the same needle valve passes 1.86 times the flow at 55 degC.
+  Scenario s = testing::held_level(0.04, 3.0, ControllerKind::basic);
+  s.effects.internal_leakage = InternalLeakage{2e-12, 1.0, 0.0};
+  s.conditions.temperature = TemperatureProfile{};
+  s.conditions.temperature->T_work = 55.0;
+  const double r = Oil::standard().ratio(55.0);
+  EXPECT_NEAR(r, 1.86, 0.01);
+  const auto run = testing::run(s);
+  for (const RigSample& sample : run) {
+    const double expected = sample.t < 1.0 ? 0.0 : r * 2e-12 * (sample.p1_true - sample.p2_true);
+    ASSERT_NEAR(sample.q_int, expected, 1e-12 * std::abs(expected) + 1e-24) << sample.t;
+  }
+  EXPECT_GT(std::abs(run.back().q_int), 1e-6);
+}
+
 TEST(Conditions, ChamberPressuresFollowASupplyStepAtRest) {
   Scenario s = testing::held_level(0.03, 16.0, ControllerKind::basic);
   s.conditions.supply = {{6.0, 14e6, 2.0}, {12.0, 16e6, 0.0}};
