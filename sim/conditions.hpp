@@ -19,8 +19,9 @@ namespace leakmon::sim {
 //   cooler:          T = T_work + amplitude sin(2 pi (t - cooler_start_s) / period_s) from
 //                    cooler_start_s on (T_work before): the thermostat's cycle as a sinusoid,
 //                    smooth and starting at T_work with no jump
-//   warm_up_cooler:  the warm-up plus the cooler's sinusoid; cooler_start_s defaults to
-//                    start_s + 3 tau_s (the oil is within 5 % of T_work)
+//   warm_up_cooler:  the warm-up plus the cooler's sinusoid; scenario files default
+//                    cooler_start_s to start_s + 3 tau_s (the oil within 5 % of T_work), code
+//                    that builds a profile sets it explicitly
 struct TemperatureProfile {
   enum class Kind { constant, warm_up, cooler, warm_up_cooler };
   Kind kind = Kind::constant;
