@@ -51,8 +51,9 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       detector_(build_detector(config, layout, period_ns)),
       alarm_(effective(config.alarm)),
       activity_(config.features.window, kNaN),
-      index_input_(layout.p2 >= 0 ? 2 : 1, kNaN) {
-  const double rate = 1e9 / static_cast<double>(period_ns);
+      index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
+      sample_rate_hz_(1e9 / static_cast<double>(period_ns)) {
+  const double rate = sample_rate_hz_;
   channels_.reserve(3);
   for (auto [role, index, spec, slot] :
        {std::tuple{"p1", layout.p1, &config.p1_transducer, &check_p1_},
@@ -74,6 +75,19 @@ AlarmSettings ActuatorMonitor::effective(const AlarmSettings& configured) const 
 void ActuatorMonitor::set_alarm_settings(const AlarmSettings& settings) {
   config_.alarm = settings;
   alarm_.set_settings(effective(settings));
+}
+
+void ActuatorMonitor::set_transducers(const ActuatorConfig& config) {
+  config_.p1_transducer = config.p1_transducer;
+  config_.p2_transducer = config.p2_transducer;
+  config_.x_transducer = config.x_transducer;
+  for (auto& channel : channels_) {
+    const std::string_view role = channel.role;
+    const auto& spec = role == "p1"   ? config_.p1_transducer
+                       : role == "p2" ? config_.p2_transducer
+                                      : config_.x_transducer;
+    channel.check.reconfigure(spec, sample_rate_hz_);
+  }
 }
 
 bool ActuatorMonitor::same_pipeline(const ActuatorConfig& other,

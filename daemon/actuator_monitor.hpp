@@ -79,6 +79,8 @@ class ActuatorMonitor {
   void acknowledge(const EventPublisher& publish);
   // Adopt new alarm settings (reload) without losing state.
   void set_alarm_settings(const AlarmSettings& settings);
+  // Adopt new transducer settings (reload): the plausibility checks keep their state.
+  void set_transducers(const ActuatorConfig& config);
   // True when `other` can take over this monitor's learned state (same signals and features).
   bool same_pipeline(const ActuatorConfig& other, const ChannelLayout& other_layout) const;
 
@@ -121,6 +123,7 @@ class ActuatorMonitor {
     detect::SensorFault announced = detect::SensorFault::none;
   };
   std::vector<Channel> channels_;
+  double sample_rate_hz_;
   int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {

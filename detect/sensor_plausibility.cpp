@@ -107,6 +107,11 @@ SensorPlausibility::SensorPlausibility(const TransducerSpec& spec, double sample
   history_.fill(kNaN);
 }
 
+void SensorPlausibility::reconfigure(const TransducerSpec& spec, double sample_rate_hz) {
+  spec_ = spec;
+  limits_ = plausibility_limits(spec, sample_rate_hz);
+}
+
 io::DeviceStatus SensorPlausibility::status() const {
   if (reported_ == SensorFault::none) return io::DeviceStatus::ok;
   if (recovering()) return io::DeviceStatus::maintenance_required;

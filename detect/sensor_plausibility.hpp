@@ -61,6 +61,9 @@ class SensorPlausibility {
 
   SensorPlausibility(const TransducerSpec& spec, double sample_rate_hz);
 
+  // New settings (a configuration reload): the limits follow, the stream's history and runs stay.
+  void reconfigure(const TransducerSpec& spec, double sample_rate_hz);
+
   // One raw sample (NaN = missing). Returns the cleaned sample of kDelay samples ago (NaN
   // before kDelay samples have arrived).
   double push(double value) noexcept;

@@ -17,6 +17,7 @@
 
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/model/test_seed.hpp"
 #include "tests/support/alloc_counter.hpp"
 
 namespace leakmon::detect {
@@ -291,6 +292,90 @@ TEST(SensorPlausibility, PushAllocatesNothing) {
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_EQ(check.spikes_rejected(), 1u);
   EXPECT_GT(sum, 0.0);
+}
+
+// Random draws (fresh seed each run, printed): rig seed, controller, channel, fault kind, onset
+// and spike sizes and places. The target is >= 95 % of faults named within 5 s of becoming
+// recognisable (spikes: of the second spike). Measured: 794 of 800 draws named (two runs of
+// 400), all six misses spikes on x under the fault-tolerant controller (its fast moves widen the
+// Hampel threshold). At a 0.75 % miss rate, more than 4 misses in 80 draws happen about once in
+// 2500 runs.
+TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
+  std::mt19937_64 random(test::model_test_seed("RandomFaultsNamedWithinFiveSeconds"));
+  constexpr int kDraws = 80;
+  int named = 0, wrong_channel = 0;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    const bool ft = random() % 2 == 1;
+    const std::string channel = kChannels[random() % 3];
+    const bool pressure = channel != "x";
+    const std::vector<SensorFault> kinds =
+        pressure ? std::vector{SensorFault::frozen, SensorFault::saturated, SensorFault::spikes,
+                               SensorFault::dropout}
+                 : std::vector{SensorFault::frozen, SensorFault::spikes, SensorFault::dropout};
+    const SensorFault kind = kinds[random() % kinds.size()];
+    const double onset_s = std::uniform_real_distribution<double>(10.0, 30.0)(random);
+    io::Capture capture = healthy(ft ? "healthy-ft" : "healthy", random() % 1000000, 60.0);
+    auto& v = capture.column(channel);
+    const auto onset = static_cast<std::size_t>(onset_s * kRate);
+    double recognisable_s = onset_s;
+    const int variant = static_cast<int>(random() % 2);
+    switch (kind) {
+      case SensorFault::frozen:
+        for (std::size_t i = onset; i < v.size(); ++i) v[i] = v[onset - 1];
+        break;
+      case SensorFault::saturated:
+        for (std::size_t i = onset; i < v.size(); ++i) {
+          v[i] =
+              variant == 0
+                  ? 4095.0 * lsb()
+                  : std::clamp(
+                        std::nearbyint(std::normal_distribution<double>(-2e3, 5e3)(random) / lsb()),
+                        0.0, 4095.0) *
+                        lsb();
+        }
+        break;
+      case SensorFault::dropout:
+        for (std::size_t i = onset; i < v.size(); ++i) v[i] = variant == 0 && pressure ? 0.0 : kNaN;
+        break;
+      case SensorFault::spikes: {
+        // 3 a minute at uniformly random places, +-1..4 MPa (x: +-2..8 mm).
+        std::uniform_real_distribution<double> size(1.0, 4.0);
+        std::size_t second = 0;
+        for (std::size_t i = onset, n = 0; i < v.size(); ++n) {
+          const double sign = random() % 2 == 0 ? 1.0 : -1.0;
+          v[i] += sign * size(random) * (pressure ? 1e6 : 2e-3);
+          if (n == 1) second = i;
+          i += static_cast<std::size_t>(std::uniform_real_distribution<double>(5.0, 35.0)(random) *
+                                        kRate);
+        }
+        recognisable_s = static_cast<double>(second) / kRate;
+        break;
+      }
+      case SensorFault::none:
+        break;
+    }
+    const Trace trace = run(capture);
+    bool ok = false;
+    for (std::size_t c = 0; c < kChannels.size(); ++c) {
+      if (kChannels[c] != channel) {
+        if (trace.faulty_samples[c] != 0) ++wrong_channel;
+        continue;
+      }
+      const long first = trace.first[c][static_cast<std::size_t>(kind)];
+      const double latency = static_cast<double>(first) / kRate - recognisable_s;
+      ok = first >= 0 && latency >= 0.0 && latency <= 5.0;
+      if (!ok) {
+        std::printf("draw %d: %s %s %s onset %.2f: first %ld (latency %.2f s)\n", draw,
+                    ft ? "ft" : "basic", channel.c_str(), std::string(to_string(kind)).c_str(),
+                    onset_s, first, latency);
+      }
+    }
+    named += ok ? 1 : 0;
+  }
+  std::printf("%d of %d faults named within 5 s, %d faults on untouched channels\n", named, kDraws,
+              wrong_channel);
+  EXPECT_EQ(wrong_channel, 0);
+  EXPECT_GE(named, kDraws * 95 / 100);
 }
 
 }  // namespace
