@@ -96,9 +96,9 @@ PlausibilityLimits plausibility_limits(const TransducerSpec& spec, double sample
   limits.spike_window = samples(kSpikeWindowSeconds, sample_rate_hz);
   limits.recovery = samples(kRecoverySeconds, sample_rate_hz);
   limits.spike_sigma = std::max(kSpikeSigmas * std::sqrt(sigma * sigma + q * q / 12.0), 2.0 * q);
-  // A transducer whose range starts at 0 (pressure) reads exactly 0 only when it is dead or
-  // pinned below its range: the physics cannot give a noise-free zero.
-  limits.zero_is_dropout = std::isfinite(spec.min) && spec.min >= 0.0 && spec.min <= q;
+  // A transducer whose range starts at or above 0 (pressure) reads exactly 0 only when it is
+  // dead or pinned below its range: the physics cannot give a noise-free zero.
+  limits.zero_is_dropout = std::isfinite(spec.min) && spec.min >= 0.0;
   return limits;
 }
 
