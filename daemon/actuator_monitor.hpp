@@ -1,8 +1,16 @@
 // One actuator's path from samples to alarm events: streaming wavelet index of p1 (and p2),
 // the hop summary the detector needs (detect::Observation), the detector, and the alarm state
-// machine. Runs on the worker thread; allocates only when built.
+// machine. Runs on the worker thread; allocates only when built (and when it publishes an event).
+//
+// Before the index, every transducer channel (p1, p2, x) passes its plausibility check
+// (detect::SensorPlausibility): isolated spikes are replaced by the median of their neighbours,
+// so the whole pipeline runs SensorPlausibility::kDelay samples (4 ms at 500 Hz) behind the
+// newest sample. A frozen, saturated, spiking or dropped-out channel raises a `sensor_fault`
+// alarm naming it, and while any channel is faulty or suspect the detector is not fed (its score
+// and learned state are held) until a full window of plausible data has passed again.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -14,6 +22,7 @@
 #include "daemon/event.hpp"
 #include "daemon/sample.hpp"
 #include "detect/detector.hpp"
+#include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
 
 namespace leakmon::daemon {
@@ -21,6 +30,14 @@ namespace leakmon::daemon {
 // Where each role's value sits in a group's Sample; -1 when the actuator does not acquire it.
 struct ChannelLayout {
   int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1;
+};
+
+// One transducer channel's plausibility, for the metrics and `leakmon status`.
+struct ChannelHealth {
+  std::string channel;  // role: p1, p2, x
+  io::DeviceStatus status = io::DeviceStatus::ok;
+  detect::SensorFault fault = detect::SensorFault::none;  // also while recovering
+  std::uint64_t spikes_rejected = 0;
 };
 
 // What the metrics and `leakmon status` show for one actuator.
@@ -38,6 +55,9 @@ struct ActuatorStatus {
   double leak_coefficient = kNoValue;
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
+  std::vector<ChannelHealth> channels;
+  bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
+  std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
 };
 
 using EventPublisher = std::function<void(const Event&)>;
@@ -59,6 +79,8 @@ class ActuatorMonitor {
   void acknowledge(const EventPublisher& publish);
   // Adopt new alarm settings (reload) without losing state.
   void set_alarm_settings(const AlarmSettings& settings);
+  // Adopt new transducer settings (reload): the plausibility checks keep their state.
+  void set_transducers(const ActuatorConfig& config);
   // True when `other` can take over this monitor's learned state (same signals and features).
   bool same_pipeline(const ActuatorConfig& other, const ChannelLayout& other_layout) const;
 
@@ -67,6 +89,7 @@ class ActuatorMonitor {
  private:
   void decide(double t, const EventPublisher& publish);
   Event alarm_event(EventKind kind, double t) const;
+  void check_sensor_faults(double t, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
 
   ActuatorConfig config_;
@@ -91,6 +114,26 @@ class ActuatorMonitor {
   std::size_t activity_next_ = 0;
   std::size_t activity_filled_ = 0;
   std::vector<double> index_input_;  // scratch: the index channels of one sample
+
+  // Plausibility of the transducer channels the layout has, and the fault each has announced.
+  struct Channel {
+    const char* role;
+    int index;
+    detect::SensorPlausibility check;
+    detect::SensorFault announced = detect::SensorFault::none;
+  };
+  std::vector<Channel> channels_;
+  double sample_rate_hz_;
+  int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
+  // u, xref and t delayed like the checked channels, so one sample stays one instant.
+  struct Unchecked {
+    double t, u, xref;
+  };
+  std::array<Unchecked, detect::SensorPlausibility::kDelay + 1> delay_{};
+  std::uint64_t arrived_ = 0;        // samples pushed (raw)
+  std::uint64_t fed_ = 0;            // delayed samples given to the features
+  std::uint64_t blocked_until_ = 0;  // no detector update before this many samples are fed
+  std::uint64_t suspended_decisions_ = 0;
 
   detect::Decision last_decision_;
   double last_t_ = kNoValue;

@@ -95,9 +95,41 @@ AlarmSettings parse_alarm(const config::ConfigNode& node) {
   return alarm;
 }
 
+// One `transducers:` entry; what is left out keeps `spec`'s value. `bits` sets the resolution
+// to the range over 2^bits (only for a finite range); `resolution` sets it directly.
+detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
+                                        detect::TransducerSpec spec) {
+  node.expect_keys({"check", "min", "max", "bits", "resolution", "noise_sigma"});
+  spec.enabled = node.get_bool("check", spec.enabled);
+  spec.min = node.get_double("min", spec.min, -1e12, 1e12);
+  spec.max = node.get_double("max", spec.max, -1e12, 1e12);
+  if (!(spec.max > spec.min)) {
+    node.fail(fmt::format("max {} must be above min {}", spec.max, spec.min));
+  }
+  if (node.has("bits") && node.has("resolution")) {
+    node.at("resolution").fail("give either bits or resolution, not both");
+  }
+  if (node.has("bits")) {
+    if (!std::isfinite(spec.min) || !std::isfinite(spec.max)) {
+      node.at("bits").fail("bits needs a finite range: give min and max (or resolution)");
+    }
+    const auto bits = node.get_int("bits", 1, 32);
+    spec.resolution = (spec.max - spec.min) / std::ldexp(1.0, static_cast<int>(bits));
+  } else if (node.has("resolution")) {
+    spec.resolution = node.get_double("resolution", 0.0, 1e12);
+  } else if (node.has("min") || node.has("max")) {
+    // A new range keeps the default's bit count (12) rather than its LSB in pascals.
+    if (std::isfinite(spec.min) && std::isfinite(spec.max)) {
+      spec.resolution = (spec.max - spec.min) / 4096.0;
+    }
+  }
+  spec.noise_sigma = node.get_double("noise_sigma", spec.noise_sigma, 0.0, 1e12);
+  return spec;
+}
+
 ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
                               std::set<std::string>& names) {
-  node.expect_keys({"name", "channels", "features", "detector", "alarm"});
+  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers"});
   ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
@@ -135,6 +167,14 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   if (auto alarm = node.find("alarm")) {
     actuator.alarm = parse_alarm(*alarm);
     actuator.alarm_name = alarm->get_string("name", actuator.alarm_name);
+  }
+  if (auto transducers = node.find("transducers")) {
+    transducers->expect_keys({"p1", "p2", "x"});
+    for (auto [role, spec] :
+         {std::pair{"p1", &actuator.p1_transducer}, std::pair{"p2", &actuator.p2_transducer},
+          std::pair{"x", &actuator.x_transducer}}) {
+      if (auto n = transducers->find(role)) *spec = parse_transducer(*n, *spec);
+    }
   }
   return actuator;
 }

@@ -59,6 +59,7 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
         if (old && old->name() == actuator.name && old->same_pipeline(actuator, layout)) {
           kept = std::move(old);
           kept->set_alarm_settings(actuator.alarm);
+          kept->set_transducers(actuator);
           break;
         }
       }
