@@ -24,6 +24,8 @@ struct Observation {
   double x = kMissing;   // position [m]
   double p1 = kMissing;  // chamber pressures [Pa]
   double p2 = kMissing;
+  double ps = kMissing;    // supply pressure [Pa], where the rig has that transducer
+  double temp = kMissing;  // oil temperature [degC], where the rig has that transducer
   // Standard deviation of the position reference or position over the window, when known: the
   // excitation that produced the index.
   double x_activity = kMissing;
