@@ -96,7 +96,8 @@ bool ActuatorMonitor::same_pipeline(const ActuatorConfig& other,
   const auto& b = other.features;
   return layout_.p1 == other_layout.p1 && layout_.p2 == other_layout.p2 &&
          layout_.u == other_layout.u && layout_.x == other_layout.x &&
-         layout_.xref == other_layout.xref && a.wavelet == b.wavelet && a.level == b.level &&
+         layout_.xref == other_layout.xref && layout_.ps == other_layout.ps &&
+         layout_.temp == other_layout.temp && a.wavelet == b.wavelet && a.level == b.level &&
          a.window == b.window && a.step == b.step && a.mode == b.mode &&
          config_.detector == other.detector &&
          yaml_text(config_.detector_options) == yaml_text(other.detector_options);
@@ -115,7 +116,8 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   }
   check_sensor_faults(sample.t, publish);
   delay_[arrived_ % delay_.size()] = {sample.t, value_at(sample, layout_.u),
-                                      value_at(sample, layout_.xref)};
+                                      value_at(sample, layout_.xref), value_at(sample, layout_.ps),
+                                      value_at(sample, layout_.temp)};
   ++arrived_;
   if (arrived_ <= kDelay) return false;
   const Unchecked& unchecked = delay_[(arrived_ - 1 - kDelay) % delay_.size()];
@@ -132,13 +134,15 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   if (std::isnan(p1)) ++gap_samples_;
 
   if (hop_samples_ >= config_.features.step) {
-    hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = HopMean{};
+    hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = hop_ps_ = hop_temp_ = HopMean{};
     hop_samples_ = 0;
   }
   hop_u_.add(unchecked.u);
   hop_x_.add(x);
   hop_p1_.add(p1);
   hop_p2_.add(p2);
+  hop_ps_.add(unchecked.ps);
+  hop_temp_.add(unchecked.temp);
   ++hop_samples_;
 
   activity_[activity_next_] = layout_.xref >= 0 ? unchecked.xref : x;
@@ -196,6 +200,8 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   observation.x = mean(hop_x_, layout_.x);
   observation.p1 = mean(hop_p1_, layout_.p1);
   observation.p2 = mean(hop_p2_, layout_.p2);
+  observation.ps = mean(hop_ps_, layout_.ps);
+  observation.temp = mean(hop_temp_, layout_.temp);
   if ((layout_.xref >= 0 || layout_.x >= 0) && activity_filled_ == activity_.size()) {
     double sum = 0.0;
     for (double v : activity_) sum += v;
@@ -204,9 +210,10 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
     for (double v : activity_) squares += (v - m) * (v - m);
     observation.x_activity = std::sqrt(squares / static_cast<double>(activity_.size()));
   }
-  hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = HopMean{};
+  hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = hop_ps_ = hop_temp_ = HopMean{};
   hop_samples_ = 0;
   last_t_ = t;
+  if (!std::isnan(observation.temp)) last_temperature_ = observation.temp;
 
   // A faulty or suspect channel: neither decide nor learn; the score and the alarm hold.
   if (fed_ < blocked_until_) {
@@ -244,11 +251,15 @@ Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
     event.leak_coefficient = c;
     event.leak_lpm_per_mpa = c * kLpmPerM3s * 1e6;
     event.load_pressure = last_load_pressure_;
-    event.leak_lpm = c * last_load_pressure_ * kLpmPerM3s;
+    // The coefficient is stated at 40 degC when the oil temperature is known; the flow is the
+    // one at the present temperature and load.
+    const double r =
+        std::isfinite(last_decision_.viscosity_ratio) ? last_decision_.viscosity_ratio : 1.0;
+    event.leak_lpm = c * r * last_load_pressure_ * kLpmPerM3s;
     const double half_width = last_decision_.leak_coefficient_ci;
     if (std::isfinite(half_width)) {
       event.leak_lpm_per_mpa_ci95 = half_width * kLpmPerM3s * 1e6;
-      event.leak_lpm_ci95 = half_width * last_load_pressure_ * kLpmPerM3s;
+      event.leak_lpm_ci95 = half_width * r * last_load_pressure_ * kLpmPerM3s;
     }
   }
   return event;
@@ -268,6 +279,8 @@ ActuatorStatus ActuatorMonitor::status() const {
   status.score = last_decision_.score;
   status.baseline = last_decision_.baseline;
   status.leak_coefficient = last_decision_.leak_coefficient;
+  status.leak_coefficient_ci = last_decision_.leak_coefficient_ci;
+  status.oil_temperature = last_temperature_;
   status.decisions = decisions_;
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;

@@ -29,7 +29,7 @@ namespace leakmon::daemon {
 
 // Where each role's value sits in a group's Sample; -1 when the actuator does not acquire it.
 struct ChannelLayout {
-  int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1;
+  int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1, ps = -1, temp = -1;
 };
 
 // One transducer channel's plausibility, for the metrics and `leakmon status`.
@@ -52,7 +52,9 @@ struct ActuatorStatus {
   double index_p2 = kNoValue;
   double score = kNoValue;
   double baseline = kNoValue;
-  double leak_coefficient = kNoValue;
+  double leak_coefficient = kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
+  double leak_coefficient_ci = kNoValue;  // its 95 % half-width
+  double oil_temperature = kNoValue;      // degC, newest hop mean of the `temp` channel
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
   std::vector<ChannelHealth> channels;
@@ -107,7 +109,7 @@ class ActuatorMonitor {
       sum += v;
     }
   };
-  HopMean hop_u_, hop_x_, hop_p1_, hop_p2_;
+  HopMean hop_u_, hop_x_, hop_p1_, hop_p2_, hop_ps_, hop_temp_;
   std::size_t hop_samples_ = 0;
   // Ring of the excitation signal (xref, else x) over the window, for Observation::x_activity.
   std::vector<double> activity_;
@@ -127,7 +129,7 @@ class ActuatorMonitor {
   int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {
-    double t, u, xref;
+    double t, u, xref, ps, temp;
   };
   std::array<Unchecked, detect::SensorPlausibility::kDelay + 1> delay_{};
   std::uint64_t arrived_ = 0;        // samples pushed (raw)
@@ -138,6 +140,7 @@ class ActuatorMonitor {
   detect::Decision last_decision_;
   double last_t_ = kNoValue;
   double last_load_pressure_ = kNoValue;
+  double last_temperature_ = kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
 };

@@ -133,15 +133,17 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
-  channels.expect_keys({"p1", "p2", "u", "x", "xref"});
+  channels.expect_keys({"p1", "p2", "u", "x", "xref", "ps", "temp"});
   actuator.p1 = parse_channel_ref(channels.at("p1"), config);
   for (auto [role, ref] : {std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
+                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
+                           std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
     if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
   }
   // One actuator's signals must be sampled together (one group, one clock).
   const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
-  for (const auto* ref : {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+  for (const auto* ref :
+       {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref, &actuator.ps, &actuator.temp}) {
     if (ref->present() && group_of_driver(config, ref->driver) != group) {
       channels.fail(
           fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
@@ -326,7 +328,8 @@ void check_channels(const DaemonConfig& config,
     }
   }
   for (const auto& actuator : config.actuators) {
-    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
+                            &actuator.ps, &actuator.temp}) {
       if (!ref->present()) continue;
       const auto& names = channels_of(ref->driver);
       if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;

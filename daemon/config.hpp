@@ -45,7 +45,7 @@ struct ChannelRef {
 struct ActuatorConfig {
   std::string name;
   // Signals by role; p1 is required, the others optional (MODEL.md names).
-  ChannelRef p1, p2, u, x, xref;
+  ChannelRef p1, p2, u, x, xref, ps, temp;
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;

@@ -18,8 +18,8 @@ ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<Channe
     }
     return -1;
   };
-  return ChannelLayout{find(actuator.p1), find(actuator.p2), find(actuator.u), find(actuator.x),
-                       find(actuator.xref)};
+  return ChannelLayout{find(actuator.p1),   find(actuator.p2), find(actuator.u),   find(actuator.x),
+                       find(actuator.xref), find(actuator.ps), find(actuator.temp)};
 }
 
 Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,

@@ -43,6 +43,9 @@ struct Decision {
   // the detector cannot size the leak.
   double leak_coefficient = kMissing;
   double leak_coefficient_ci = kMissing;
+  // nu(40 degC) / nu(T) at the oil temperature of this hop when the detector knows it (the
+  // leak coefficient is then stated at 40 degC and flows r C_L (p1 - p2) now); NaN otherwise.
+  double viscosity_ratio = kMissing;
 };
 
 class Detector {

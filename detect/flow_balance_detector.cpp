@@ -307,8 +307,8 @@ Decision FlowBalanceDetector::update(const Observation& o) {
         options_.piston_area * hop.speed / (options_.valve_coefficient * std::sqrt(ps_ref) * root);
     // Laminar leaks follow the viscosity: scaled to 40 degC, the learned null leakage and any
     // new leak are constants of the rig.
-    const double viscosity_ratio = std::isnan(o.temp) ? 1.0 : options_.oil.ratio(o.temp);
-    hop.leak_term = hop.load / root * viscosity_ratio;
+    hop.viscosity_ratio = std::isnan(o.temp) ? kMissing : options_.oil.ratio(o.temp);
+    hop.leak_term = hop.load / root * (std::isnan(o.temp) ? 1.0 : hop.viscosity_ratio);
     hop.root = root;
   }
   auto still = [&](const Hop& h) { return h.usable && std::abs(h.speed) < options_.rest_speed; };
@@ -354,6 +354,7 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
     block_residual_sum_ = block_leak_term_sum_ = 0.0;
   }
   decision.score = cusum_.normalised();
+  decision.viscosity_ratio = hop.viscosity_ratio;
   const SlopeSums& sums = cusum_.value() <= 0.0    ? weighted_
                           : since_change_.ll > 0.0 ? since_change_
                           : change_block_.ll > 0.0 ? change_block_

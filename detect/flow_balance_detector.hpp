@@ -83,8 +83,9 @@ class FlowBalanceDetector final : public Detector {
     double leak_term = kMissing;  // load / root: the opening a leak needs per unit C sqrt(ps)/Kv
                                   // (times the viscosity ratio with a temperature)
     double speed = kMissing;
-    double supply = kMissing;  // supply pressure used for this hop [Pa]
-    bool usable = false;       // all signals present and the command within the valve's range
+    double supply = kMissing;           // supply pressure used for this hop [Pa]
+    double viscosity_ratio = kMissing;  // nu(40) / nu(T) with a temperature
+    bool usable = false;  // all signals present and the command within the valve's range
   };
   struct RestHop {
     Hop hop;
