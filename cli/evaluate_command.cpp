@@ -23,8 +23,8 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/replay.hpp"
 #include "detect/factory.hpp"
 #include "io/capture/capture.hpp"

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "dsp/streaming_features.hpp"
 
 namespace leakmon::cli {
