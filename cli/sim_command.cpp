@@ -9,8 +9,8 @@
 #include <string>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 
