@@ -73,6 +73,11 @@ int run_evaluate(int argc, char** argv) {
       .option("jobs", "N", "parallel runs", "2")
       .option("effects", "LIST",
               "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
+      .option("conditions", "LIST",
+              "operating conditions the runs cycle through, comma-separated: stationary, warmup, "
+              "cooler, supply, sensor-faults (MODEL.md drifting conditions and sensor faults); "
+              "adds conditions.md and conditions.tsv",
+              "stationary")
       .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
               "")
       .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
@@ -96,6 +101,16 @@ int run_evaluate(int argc, char** argv) {
       throw UsageError(fmt::format("option '--effects': {}", e.what()));
     }
   }
+  settings.conditions = split(args.get("conditions"));
+  for (const auto& condition : settings.conditions) {
+    if (!study::is_condition(condition)) {
+      throw UsageError(fmt::format(
+          "option '--conditions': unknown condition '{}' (known: stationary, warmup, cooler, "
+          "supply, sensor-faults)",
+          condition));
+    }
+  }
+  if (settings.conditions.empty()) settings.conditions = {"stationary"};
   if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.jobs < 1) {
     throw UsageError("run counts must be >= 0 and --jobs >= 1");
   }
@@ -126,8 +141,11 @@ int run_evaluate(int argc, char** argv) {
 
   study::write_runs_json(out / "runs.json", results);
   study::write_summaries(out, settings, results);
-  fmt::print("wrote {}/runs.json, summary.json, summary.tsv, summary.md, size_coverage.tsv\n",
-             out.string());
+  study::write_condition_summaries(out, settings, results);
+  fmt::print(
+      "wrote {}/runs.json, summary.json, summary.tsv, summary.md, size_coverage.tsv, "
+      "conditions.md, conditions.tsv\n",
+      out.string());
 
   if (args.flag_set("plots")) {
     const std::string command =

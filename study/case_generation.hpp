@@ -32,7 +32,8 @@ struct LeakCondition {
 struct Condition {
   using Kind = std::variant<HealthyCondition, LeakCondition>;
   Kind kind;
-  std::vector<std::string> effects;  // MODEL.md effects on from the start (default parameters)
+  std::vector<std::string> effects;      // MODEL.md effects on from the start (default parameters)
+  std::string operating = "stationary";  // one of kConditionNames: how the rig drifts
 };
 
 // One run to simulate and the truth to score it against.
@@ -43,6 +44,9 @@ struct RunSpec {
   double leak = 0.0;        // C_L [m^3/(s Pa)], 0 healthy
   double onset = 1e300;     // leak onset [s]
   double monitor_from = 0;  // end of settle + learning [s]
+  // sensor-faults: the injected fault (channel name and kind as the alarm names them), and when.
+  std::string fault_channel, fault_kind;
+  double fault_start = NAN, fault_end = NAN;
 };
 
 // The evaluation's conditions in run order: healthy_runs healthy runs, then runs_per_leak leak

@@ -15,7 +15,15 @@ std::vector<Candidate> candidates() {
       {"flow_balance", "flow_balance", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
       {"fused", "fused", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
       {"default", "default", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
+      // The daemon's default with an oil temperature transducer too (drifting conditions).
+      {"default_temp", "default", true, true, true, cusum_grid, 1.0, 0.0, 0.5, true},
+      {"index_cusum_temp", "index_cusum", true, false, false, cusum_grid, 1.0, 0.0, 0.5, true},
   };
+}
+
+bool is_condition(std::string_view name) {
+  return std::find(std::begin(kConditionNames), std::end(kConditionNames), name) !=
+         std::end(kConditionNames);
 }
 
 std::size_t design_index(const Candidate& candidate) {

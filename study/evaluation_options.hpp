@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace leakmon::study {
@@ -22,7 +23,11 @@ struct EvaluationOptions {
   std::uint64_t seed = 1;
   int jobs = 2;
   std::vector<std::string> effects;  // MODEL.md effect names on every run (default parameters)
-  std::vector<int> keep_captures;    // run ids whose capture CSV is written into `out`
+  // Operating conditions the runs are drawn under, in turn (kConditionNames; "stationary" is
+  // MODEL.md's stationary rig at 40 degC). Runs under any other condition record `temp` and
+  // `ps`, and candidates choose whether to use them.
+  std::vector<std::string> conditions = {"stationary"};
+  std::vector<int> keep_captures;  // run ids whose capture CSV is written into `out`
   std::filesystem::path out;
 };
 
@@ -36,9 +41,19 @@ struct Candidate {
   double design_threshold;
   double clear_gap;  // clear = raise * clear_ratio (or raise - clear_gap when > 0)
   double clear_ratio;
+  bool temp = false;  // also the oil temperature channel, where the capture has one
 };
 
 std::vector<Candidate> candidates();
+
+// The conditions `--conditions` takes: stationary, warmup (a morning warm-up from 15-35 degC to
+// 45-55 degC, time constant 5-20 min, learning during it), cooler (a warm rig cycling +-1-4 K
+// every 5-20 min), supply (one or two set-point changes to 13-20 MPa), sensor-faults (one fault
+// of one transducer: frozen, saturated, spikes or dropout, 10-60 s), each with an oil grade VG
+// 32, 46 or 68.
+inline constexpr std::string_view kConditionNames[] = {"stationary", "warmup", "cooler", "supply",
+                                                       "sensor-faults"};
+bool is_condition(std::string_view name);
 
 // Position of the design threshold in `raise_thresholds` (its size when absent).
 std::size_t design_index(const Candidate& candidate);

@@ -78,6 +78,8 @@ daemon::DaemonConfig evaluation_config(const io::Capture& capture,
       if (!candidate.p2) a.p2 = {};
       if (!candidate.u) a.u = {};
       if (!candidate.x) a.x = {};
+      if (!candidate.temp) a.temp = {};
+      a.ps = {};  // the detectors read the supply from the chamber pressures at rest
       const double raise = candidate.raise_thresholds[t];
       a.alarm.raise_threshold = raise;
       a.alarm.clear_threshold =
@@ -110,8 +112,15 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
       by_name[actuator_name(c, t)] = {c, t};
     }
   }
+  const std::string sensor_actuator =
+      actuator_name(kSensorCandidate, design_index(all[kSensorCandidate]));
   for (const auto& event : replay.events) {
     if (event.kind != daemon::EventKind::alarm_raised) continue;
+    if (event.alarm == "sensor_fault") {
+      if (event.actuator == sensor_actuator)
+        result.sensor_alarms.push_back({event.t, event.channel, event.fault});
+      continue;
+    }
     const auto found = by_name.find(event.actuator);
     if (found == by_name.end()) continue;
     result.alarms[found->second.first][found->second.second].push_back(

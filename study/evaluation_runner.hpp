@@ -30,6 +30,14 @@ struct SizeCheck {
   bool covers(double truth) const { return std::abs(leak_coefficient - truth) <= half_width; }
 };
 
+// A sensor_fault alarm raised in the run (the daemon's default actuator at its design threshold).
+struct SensorAlarm {
+  double t = NAN;
+  std::string channel, fault;
+};
+// The candidate whose sensor_fault alarms a run records: "default".
+inline constexpr std::size_t kSensorCandidate = 5;
+
 // One run's record.
 struct RunResult {
   RunSpec spec;
@@ -37,6 +45,7 @@ struct RunResult {
   // [candidate][threshold] -> raise times and sizes
   std::vector<std::vector<std::vector<Alarm>>> alarms;
   double seconds = 0.0;
+  std::vector<SensorAlarm> sensor_alarms;
 };
 
 // The learning and settling periods every candidate's detector is configured with.

@@ -28,11 +28,11 @@ void write_runs_json(const std::filesystem::path& path, const std::vector<RunRes
     f.print(
         "  {{\"id\": {}, \"controller\": \"{}\", \"seconds\": {}, \"leak\": {}, "
         "\"onset\": {}, \"K_s\": {}, \"beta\": {}, \"Kv\": {}, \"m\": {}, \"b\": {}, "
-        "\"amp_max\": {}, \"alarms\": {{",
+        "\"amp_max\": {}, \"operating\": \"{}\", \"alarms\": {{",
         r.spec.id, sim::to_string(s.controller), json_number(r.seconds), json_number(r.spec.leak),
         json_number(r.spec.leak > 0 ? r.spec.onset : NAN), json_number(s.params.K_s),
         json_number(s.params.beta), json_number(s.params.Kv), json_number(s.params.m),
-        json_number(s.params.b), json_number(s.reference.amp_max));
+        json_number(s.params.b), json_number(s.reference.amp_max), r.spec.condition.operating);
     for (std::size_t c = 0; c < all.size(); ++c) {
       f.print("{}\"{}\": [", c ? ", " : "", all[c].label);
       const auto& alarms = r.alarms[c][design_index(all[c])];
@@ -144,6 +144,69 @@ void write_summaries(const std::filesystem::path& dir, const EvaluationOptions& 
   }
   f_md.close();
   f_tsv_coverage.close();
+}
+
+void write_condition_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
+                               const std::vector<RunResult>& results) {
+  const auto all = candidates();
+  auto f_md = fmt::output_file((dir / "conditions.md").string());
+  auto f_tsv = fmt::output_file((dir / "conditions.tsv").string());
+  f_tsv.print(
+      "condition\tdetector\tleak\tfalse_alarms\thealthy_hours\tfa_per_hour\tfa_upper_95\t"
+      "detected\tleak_runs\tmedian_delay\n");
+  f_md.print(
+      "| condition | detector | false alarms / h (count in healthy h; 95 % upper bound) | {} |\n"
+      "|---|---|---|{}\n",
+      fmt::join(options.leak_sizes, " | "), [&] {
+        std::string columns;
+        for (std::size_t i = 0; i < options.leak_sizes.size(); ++i) columns += "---|";
+        return columns;
+      }());
+  for (const auto& condition : options.conditions) {
+    std::vector<RunResult> subset;
+    for (const auto& r : results) {
+      if (r.spec.condition.operating == condition) subset.push_back(r);
+    }
+    for (std::size_t c = 0; c < all.size(); ++c) {
+      const std::size_t t = design_index(all[c]);
+      const Rates healthy = rates_of(subset, c, t, "all", 0.0, options.detect_within);
+      f_md.print("| {} | {} | {:.2f} ({} in {:.1f} h; <= {:.2f}) |", condition, all[c].label,
+                 healthy.false_alarms_per_hour(), healthy.false_alarms, healthy.healthy_hours,
+                 healthy.false_alarms_per_hour_upper_95());
+      for (double size : options.leak_sizes) {
+        const Rates rates = rates_of(subset, c, t, "all", size, options.detect_within);
+        f_md.print(
+            " {}/{}{} |", rates.detected, rates.leak_runs,
+            rates.delays.empty() ? std::string() : fmt::format(", {:.1f} s", rates.median_delay()));
+        f_tsv.print("{}\t{}\t{:g}\t{}\t{:.4g}\t{:.4g}\t{:.4g}\t{}\t{}\t{:.4g}\n", condition,
+                    all[c].label, size, healthy.false_alarms, healthy.healthy_hours,
+                    healthy.false_alarms_per_hour(), healthy.false_alarms_per_hour_upper_95(),
+                    rates.detected, rates.leak_runs, rates.median_delay());
+      }
+      f_md.print("\n");
+    }
+  }
+  // Sensor faults: named on the right channel within 5 s of the fault's start.
+  int faults = 0, named = 0, wrong_channel = 0;
+  for (const auto& r : results) {
+    if (r.spec.fault_channel.empty()) continue;
+    ++faults;
+    bool found = false;
+    for (const auto& a : r.sensor_alarms) {
+      if (a.t < r.spec.fault_start || a.t > r.spec.fault_end + 5.0) continue;
+      if (a.channel == r.spec.fault_channel && a.t <= r.spec.fault_start + 5.0) found = true;
+      if (a.channel != r.spec.fault_channel) ++wrong_channel;
+    }
+    named += found ? 1 : 0;
+  }
+  if (faults > 0) {
+    const Interval ci = clopper_pearson_95(named, faults);
+    f_md.print(
+        "\nSensor faults: {}/{} named on the faulty channel within 5 s (95 % interval "
+        "{:.0f}-{:.0f} "
+        "%); {} sensor_fault alarms on another channel while a fault was present.\n",
+        named, faults, 100.0 * ci.lower, 100.0 * ci.upper, wrong_channel);
+  }
 }
 
 }  // namespace leakmon::study

@@ -19,4 +19,11 @@ void write_runs_json(const std::filesystem::path& path, const std::vector<RunRes
 void write_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
                      const std::vector<RunResult>& results);
 
+// conditions.md and conditions.tsv into `dir`: per operating condition (options.conditions), each
+// candidate's false alarms per healthy hour (count, hours, 95 % upper bound) and detection within
+// the window per leak size at its design threshold; for sensor-faults runs, how many faults were
+// named on the right channel within 5 s, and any internal_leakage raised while one was present.
+void write_condition_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
+                               const std::vector<RunResult>& results);
+
 }  // namespace leakmon::study
