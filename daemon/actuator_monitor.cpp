@@ -140,18 +140,18 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   ++decisions_;
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
-  if (transition.raised) publish(alarm_event(EventKind::alarm_raised, t));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, t));
+  if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, t));
 }
 
 void ActuatorMonitor::acknowledge(const EventPublisher& publish) {
   const AlarmTransition transition = alarm_.acknowledge();
-  if (transition.acknowledged) publish(alarm_event(EventKind::alarm_acknowledged, last_t_));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, last_t_));
+  if (transition.acknowledged) publish(alarm_event(io::EventKind::alarm_acknowledged, last_t_));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, last_t_));
 }
 
-Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
-  Event event;
+io::Event ActuatorMonitor::alarm_event(io::EventKind kind, double t) const {
+  io::Event event;
   event.kind = kind;
   event.t = t;
   event.actuator = config_.name;

@@ -11,10 +11,10 @@
 
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event.hpp"
 #include "daemon/sample.hpp"
 #include "detect/detector.hpp"
 #include "dsp/streaming_features.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
@@ -30,17 +30,17 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
-  double t = kNoValue;         // source time of the newest decision
-  double index_p1 = kNoValue;  // Pa
-  double index_p2 = kNoValue;
-  double score = kNoValue;
-  double baseline = kNoValue;
-  double leak_coefficient = kNoValue;
+  double t = io::kNoValue;         // source time of the newest decision
+  double index_p1 = io::kNoValue;  // Pa
+  double index_p2 = io::kNoValue;
+  double score = io::kNoValue;
+  double baseline = io::kNoValue;
+  double leak_coefficient = io::kNoValue;
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
 };
 
-using EventPublisher = std::function<void(const Event&)>;
+using EventPublisher = std::function<void(const io::Event&)>;
 
 class ActuatorMonitor {
  public:
@@ -66,7 +66,7 @@ class ActuatorMonitor {
 
  private:
   void decide(double t, const EventPublisher& publish);
-  Event alarm_event(EventKind kind, double t) const;
+  io::Event alarm_event(io::EventKind kind, double t) const;
   AlarmSettings effective(const AlarmSettings& configured) const;
 
   ActuatorConfig config_;
@@ -93,8 +93,8 @@ class ActuatorMonitor {
   std::vector<double> index_input_;  // scratch: the index channels of one sample
 
   detect::Decision last_decision_;
-  double last_t_ = kNoValue;
-  double last_load_pressure_ = kNoValue;
+  double last_t_ = io::kNoValue;
+  double last_load_pressure_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
 };

@@ -23,11 +23,11 @@
 #include <thread>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "daemon/cli/args.hpp"
 #include "daemon/cli/subcommands.hpp"
 #include "daemon/replay.hpp"
 #include "detect/factory.hpp"
-#include "io/capture/capture.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 
@@ -173,7 +173,7 @@ config::ConfigNode detector_options(const Settings& settings) {
       "leakmon evaluate");
 }
 
-daemon::DaemonConfig evaluation_config(const io::Capture& capture, const Settings& settings) {
+daemon::DaemonConfig evaluation_config(const capture::Capture& capture, const Settings& settings) {
   daemon::DaemonConfig config = daemon::default_replay_config(capture);
   const daemon::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
@@ -199,7 +199,7 @@ daemon::DaemonConfig evaluation_config(const io::Capture& capture, const Setting
   return config;
 }
 
-SizeCheck check_size(const io::Capture& capture, const RunSpec& spec, const Settings& settings,
+SizeCheck check_size(const capture::Capture& capture, const RunSpec& spec, const Settings& settings,
                      const config::ConfigNode& options) {
   constexpr std::size_t kStep = 20;  // the daemon's default hop
   const double hop_seconds = static_cast<double>(kStep) / capture.sample_rate_hz();
@@ -233,10 +233,10 @@ SizeCheck check_size(const io::Capture& capture, const RunSpec& spec, const Sett
 RunResult evaluate_run(const RunSpec& spec, const Settings& settings) {
   RunResult result;
   result.spec = spec;
-  const io::Capture capture = sim::simulate(spec.scenario);
+  const capture::Capture capture = sim::simulate(spec.scenario);
   if (std::find(settings.keep_captures.begin(), settings.keep_captures.end(), spec.id) !=
       settings.keep_captures.end()) {
-    io::write_capture((settings.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
+    capture::write_capture((settings.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
   }
   const daemon::ReplayResult replay =
       daemon::replay_capture(capture, evaluation_config(capture, settings));
@@ -253,7 +253,7 @@ RunResult evaluate_run(const RunSpec& spec, const Settings& settings) {
     }
   }
   for (const auto& event : replay.events) {
-    if (event.kind != daemon::EventKind::alarm_raised) continue;
+    if (event.kind != io::EventKind::alarm_raised) continue;
     const auto found = by_name.find(event.actuator);
     if (found == by_name.end()) continue;
     result.alarms[found->second.first][found->second.second].push_back(

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon {
@@ -32,7 +32,7 @@ TEST(SimCommand, PresetWritesTheCaptureWithMetadata) {
   const std::string dir = test::scratch_dir("sim_command_preset");
   const Result r = run("--preset paper-fig10 --seed 7 --duration 2 --out " + dir + "/fig10.csv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const io::Capture capture = io::read_capture(dir + "/fig10.csv");
+  const capture::Capture capture = capture::read_capture(dir + "/fig10.csv");
   for (const char* column : {"t", "xref", "u", "x", "p1", "p2", "q_int"}) {
     EXPECT_TRUE(capture.has(column)) << column;
   }
@@ -49,7 +49,7 @@ TEST(SimCommand, ScenarioFileRunsAndBadFilesFailWithTheirLocation) {
       run("--scenario " + test::source_dir() +
           "/sim/scenarios/supply-disturbances.yaml --duration 1 --out " + dir + "/s.csv");
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
-  const io::Capture capture = io::read_capture(dir + "/s.csv");
+  const capture::Capture capture = capture::read_capture(dir + "/s.csv");
   EXPECT_EQ(capture.rows(), 500u);
   int effects = 0;
   for (const auto& [key, value] : capture.metadata) effects += key == "effect";
