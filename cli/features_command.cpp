@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "dsp/block_features.hpp"
 #include "dsp/streaming_features.hpp"
-#include "io/capture/capture.hpp"
 
 namespace leakmon::cli {
 namespace {
@@ -67,12 +67,12 @@ int run_features(int argc, char** argv) {
 
   const std::string in_path = args.get("in");
   const std::string channel = args.get("channel");
-  io::CaptureReader reader(in_path);
+  capture::CaptureReader reader(in_path);
   const auto column = reader.column_index(channel);
   if (!column) {
     std::string present;
     for (const auto& name : reader.columns()) present += (present.empty() ? "" : ", ") + name;
-    throw io::CaptureError(
+    throw capture::CaptureError(
         fmt::format("{}: no column '{}' (columns: {})", in_path, channel, present));
   }
 
@@ -94,10 +94,10 @@ int run_features(int argc, char** argv) {
   std::uint64_t windows = 0;
   std::uint64_t gap_windows = 0;
   auto write_window = [&](const dsp::WindowFeature& f) {
-    io::append_number(text, times[f.last_sample - chunk_first]);
+    capture::append_number(text, times[f.last_sample - chunk_first]);
     text += ',';
     if (f.feature.valid) {
-      io::append_number(text, f.feature.rms);
+      capture::append_number(text, f.feature.rms);
     } else {
       ++gap_windows;
     }

@@ -4,12 +4,12 @@
 
 #include <fstream>
 
+#include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/replay.hpp"
-#include "io/capture/capture.hpp"
 
 namespace leakmon::cli {
 
@@ -24,7 +24,7 @@ int run_replay(int argc, char** argv) {
   args.flag("realtime", "pace at the capture's own rate instead of as fast as possible");
   if (!args.parse(argc, argv)) return 0;
 
-  auto capture = std::make_shared<const io::Capture>(io::read_capture(args.get("in")));
+  auto capture = std::make_shared<const capture::Capture>(capture::read_capture(args.get("in")));
   const daemon::DaemonConfig config = args.get("config").empty()
                                           ? daemon::default_replay_config(*capture)
                                           : daemon::load_config(args.get("config"));

@@ -158,18 +158,18 @@ void ActuatorMonitor::check_sensor_faults(double t, const EventPublisher& publis
   for (auto& channel : channels_) {
     const detect::SensorFault fault = channel.check.fault();
     if (fault == channel.announced) continue;
-    Event event;
+    io::Event event;
     event.t = t;
     event.actuator = config_.name;
     event.alarm = "sensor_fault";
     event.channel = channel.role;
     if (channel.announced != detect::SensorFault::none) {
-      event.kind = EventKind::alarm_cleared;
+      event.kind = io::EventKind::alarm_cleared;
       event.fault = std::string(detect::to_string(channel.announced));
       publish(event);
     }
     if (fault != detect::SensorFault::none) {
-      event.kind = EventKind::alarm_raised;
+      event.kind = io::EventKind::alarm_raised;
       event.fault = std::string(detect::to_string(fault));
       event.message = fmt::format("{} {}: {} ({})", config_.name, channel.role, event.fault,
                                   io::to_string(detect::device_status(fault)));
@@ -225,18 +225,18 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   ++decisions_;
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
-  if (transition.raised) publish(alarm_event(EventKind::alarm_raised, t));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, t));
+  if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, t));
 }
 
 void ActuatorMonitor::acknowledge(const EventPublisher& publish) {
   const AlarmTransition transition = alarm_.acknowledge();
-  if (transition.acknowledged) publish(alarm_event(EventKind::alarm_acknowledged, last_t_));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, last_t_));
+  if (transition.acknowledged) publish(alarm_event(io::EventKind::alarm_acknowledged, last_t_));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, last_t_));
 }
 
-Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
-  Event event;
+io::Event ActuatorMonitor::alarm_event(io::EventKind kind, double t) const {
+  io::Event event;
   event.kind = kind;
   event.t = t;
   event.actuator = config_.name;

@@ -19,11 +19,11 @@
 
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event.hpp"
 #include "daemon/sample.hpp"
 #include "detect/detector.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
@@ -47,14 +47,14 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
-  double t = kNoValue;         // source time of the newest decision
-  double index_p1 = kNoValue;  // Pa
-  double index_p2 = kNoValue;
-  double score = kNoValue;
-  double baseline = kNoValue;
-  double leak_coefficient = kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
-  double leak_coefficient_ci = kNoValue;  // its 95 % half-width
-  double oil_temperature = kNoValue;      // degC, newest hop mean of the `temp` channel
+  double t = io::kNoValue;         // source time of the newest decision
+  double index_p1 = io::kNoValue;  // Pa
+  double index_p2 = io::kNoValue;
+  double score = io::kNoValue;
+  double baseline = io::kNoValue;
+  double leak_coefficient = io::kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
+  double leak_coefficient_ci = io::kNoValue;  // its 95 % half-width
+  double oil_temperature = io::kNoValue;      // degC, newest hop mean of the `temp` channel
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
   std::vector<ChannelHealth> channels;
@@ -62,7 +62,7 @@ struct ActuatorStatus {
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
 };
 
-using EventPublisher = std::function<void(const Event&)>;
+using EventPublisher = std::function<void(const io::Event&)>;
 
 class ActuatorMonitor {
  public:
@@ -90,7 +90,7 @@ class ActuatorMonitor {
 
  private:
   void decide(double t, const EventPublisher& publish);
-  Event alarm_event(EventKind kind, double t) const;
+  io::Event alarm_event(io::EventKind kind, double t) const;
   void check_sensor_faults(double t, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
 
@@ -138,9 +138,9 @@ class ActuatorMonitor {
   std::uint64_t suspended_decisions_ = 0;
 
   detect::Decision last_decision_;
-  double last_t_ = kNoValue;
-  double last_load_pressure_ = kNoValue;
-  double last_temperature_ = kNoValue;
+  double last_t_ = io::kNoValue;
+  double last_load_pressure_ = io::kNoValue;
+  double last_temperature_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
 };

@@ -77,8 +77,8 @@ std::string overridden_parameters(const Parameters& p) {
 
 }  // namespace
 
-io::Metadata capture_metadata(const Scenario& scenario) {
-  io::Metadata meta;
+capture::Metadata capture_metadata(const Scenario& scenario) {
+  capture::Metadata meta;
   meta.emplace_back("sample_rate_hz", fmt::format("{:g}", scenario.sample_rate_hz));
   meta.emplace_back(
       "source", fmt::format("sim {} seed {}",
@@ -136,8 +136,8 @@ io::Metadata capture_metadata(const Scenario& scenario) {
   return meta;
 }
 
-io::Capture simulate(const Scenario& scenario) {
-  io::Capture capture;
+capture::Capture simulate(const Scenario& scenario) {
+  capture::Capture capture;
   capture.metadata = capture_metadata(scenario);
   capture.columns = columns(scenario);
   const std::uint64_t n = scenario.samples();
@@ -152,7 +152,7 @@ io::Capture simulate(const Scenario& scenario) {
 }
 
 void simulate_to_file(const Scenario& scenario, const std::string& path) {
-  io::CaptureWriter writer(path, columns(scenario), capture_metadata(scenario));
+  capture::CaptureWriter writer(path, columns(scenario), capture_metadata(scenario));
   Rig rig(scenario);
   const std::uint64_t n = scenario.samples();
   std::array<double, 9> values{};

@@ -22,7 +22,7 @@ namespace {
 // coverage is measured here, independently of the alarm logic: the flow balance is run once
 // more on the capture's hop means (the same Observation fields the worker fills) and its first
 // raise at its own threshold within detect_within of the onset is taken.
-SizeCheck check_size(const io::Capture& capture, const RunSpec& spec,
+SizeCheck check_size(const capture::Capture& capture, const RunSpec& spec,
                      const EvaluationOptions& options, const config::ConfigNode& detector_config) {
   constexpr std::size_t kStep = 20;  // the daemon's default hop
   const double hop_seconds = static_cast<double>(kStep) / capture.sample_rate_hz();
@@ -61,7 +61,7 @@ config::ConfigNode detector_options(const EvaluationOptions& options) {
                                          "leakmon evaluate");
 }
 
-daemon::DaemonConfig evaluation_config(const io::Capture& capture,
+daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
                                        const EvaluationOptions& options) {
   daemon::DaemonConfig config = daemon::default_replay_config(capture);
   const daemon::ActuatorConfig base = config.actuators.at(0);
@@ -93,10 +93,10 @@ daemon::DaemonConfig evaluation_config(const io::Capture& capture,
 RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
   RunResult result;
   result.spec = spec;
-  const io::Capture capture = sim::simulate(spec.scenario);
+  const capture::Capture capture = sim::simulate(spec.scenario);
   if (std::find(options.keep_captures.begin(), options.keep_captures.end(), spec.id) !=
       options.keep_captures.end()) {
-    io::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
+    capture::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
   }
   const daemon::ReplayResult replay =
       daemon::replay_capture(capture, evaluation_config(capture, options));
@@ -115,7 +115,7 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
   const std::string sensor_actuator =
       actuator_name(kSensorCandidate, design_index(all[kSensorCandidate]));
   for (const auto& event : replay.events) {
-    if (event.kind != daemon::EventKind::alarm_raised) continue;
+    if (event.kind != io::EventKind::alarm_raised) continue;
     if (event.alarm == "sensor_fault") {
       if (event.actuator == sensor_actuator)
         result.sensor_alarms.push_back({event.t, event.channel, event.fault});

@@ -10,7 +10,7 @@
 
 #include "config/yaml_reader.hpp"
 #include "daemon/config.hpp"
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
 
@@ -52,7 +52,7 @@ struct RunResult {
 config::ConfigNode detector_options(const EvaluationOptions& options);
 
 // The daemon configuration that replays `capture`: one actuator per candidate and threshold.
-daemon::DaemonConfig evaluation_config(const io::Capture& capture,
+daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
                                        const EvaluationOptions& options);
 
 // Simulates and replays one run (and writes its capture when options.keep_captures names it).

@@ -62,7 +62,7 @@ void SimDriver::start() {
   source_time_.reset();
 }
 
-ReadStatus SimDriver::read(const Tick& /*tick*/, std::span<double> values) {
+ReadStatus SimDriver::read(const Tick& /*tick*/, std::span<double> values) noexcept {
   const sim::RigSample sample = rig_->step();
   for (std::size_t i = 0; i < fields_.size() && i < values.size(); ++i) {
     values[i] = field(sample, fields_[i]);

@@ -43,7 +43,7 @@ class SimDriver final : public Driver {
   std::span<const std::string> channels() const override { return channels_; }
   void start() override;
   void stop() override {}
-  ReadStatus read(const Tick& tick, std::span<double> values) override;
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override { return source_time_; }
 
  private:

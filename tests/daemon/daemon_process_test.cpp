@@ -11,8 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "capture/capture.hpp"
 #include "daemon/http_endpoint.hpp"
-#include "io/capture/capture.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -71,8 +71,8 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   sim::Scenario scenario = sim::preset("paper-fig10", 5);
   scenario.duration_s = 26.0;
   scenario.effects.internal_leakage->onset_s = kOnset;
-  const io::Capture capture = sim::simulate(scenario);
-  io::write_capture(dir + "/capture.csv", capture);
+  const capture::Capture capture = sim::simulate(scenario);
+  capture::write_capture(dir + "/capture.csv", capture);
 
   const int port = free_port();
   const std::string cfg = dir + "/leakmon.yaml";
@@ -171,7 +171,7 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   ASSERT_GE(files.size(), 1u);
   std::uint64_t row = 0;
   for (const auto& file : files) {
-    const io::Capture recorded = io::read_capture(file);
+    const capture::Capture recorded = capture::read_capture(file);
     for (std::size_t i = 0; i < recorded.rows(); ++i, ++row) {
       ASSERT_LT(row, capture.rows());
       ASSERT_EQ(recorded.column("t")[i], capture.column("t")[row]) << file << " row " << i;

@@ -16,7 +16,7 @@ namespace {
 constexpr double kOnset = 700.0;
 constexpr double kLeak = 1e-12;  // at 40 degC
 
-io::Capture drifting_capture(bool record_temp) {
+capture::Capture drifting_capture(bool record_temp) {
   sim::Scenario s;
   s.seed = 31;
   s.duration_s = kOnset + 60.0;
@@ -32,11 +32,11 @@ io::Capture drifting_capture(bool record_temp) {
   return sim::simulate(s);
 }
 
-std::vector<Event> leak_alarms(const ReplayResult& result) {
-  std::vector<Event> out;
+std::vector<io::Event> leak_alarms(const ReplayResult& result) {
+  std::vector<io::Event> out;
   std::copy_if(result.events.begin(), result.events.end(), std::back_inserter(out),
-               [](const Event& e) {
-                 return e.kind == EventKind::alarm_raised && e.alarm == "internal_leakage";
+               [](const io::Event& e) {
+                 return e.kind == io::EventKind::alarm_raised && e.alarm == "internal_leakage";
                });
   return out;
 }
@@ -44,7 +44,7 @@ std::vector<Event> leak_alarms(const ReplayResult& result) {
 TEST(DriftReplay, WarmUpAndSupplyChangeAreNotALeakAndTheLeakAfterIsSizedAt40C) {
   for (const bool with_temp : {true, false}) {
     SCOPED_TRACE(with_temp ? "temp column" : "no temp column");
-    const io::Capture capture = drifting_capture(with_temp);
+    const capture::Capture capture = drifting_capture(with_temp);
     const DaemonConfig config = default_replay_config(capture);
     EXPECT_EQ(config.actuators.front().temp.present(), with_temp);
     const ReplayResult result = replay_capture(capture, config);

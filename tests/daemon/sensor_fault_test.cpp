@@ -24,7 +24,7 @@ constexpr double kRate = 500.0;
 // The default detector settles 2 s and learns 90 s; the fault comes after that, the leak later.
 constexpr double kFreezeFrom = 120.0, kFreezeTo = 150.0, kLeakOnset = 210.0;
 
-io::Capture capture(std::uint64_t seed, std::string_view preset, double duration,
+capture::Capture capture(std::uint64_t seed, std::string_view preset, double duration,
                     std::optional<double> leak_onset) {
   sim::Scenario scenario = sim::preset(preset, seed);
   scenario.duration_s = duration;
@@ -40,28 +40,28 @@ io::Capture capture(std::uint64_t seed, std::string_view preset, double duration
 
 std::size_t row_at(double t) { return static_cast<std::size_t>(std::lround(t * kRate)); }
 
-void freeze(io::Capture& c, const std::string& channel, double from, double to) {
+void freeze(capture::Capture& c, const std::string& channel, double from, double to) {
   auto& v = c.column(channel);
   for (std::size_t i = row_at(from); i < row_at(to) && i < v.size(); ++i)
     v[i] = v[row_at(from) - 1];
 }
 
-std::vector<Event> events_of(const ReplayResult& r, EventKind kind, const std::string& alarm) {
-  std::vector<Event> out;
+std::vector<io::Event> events_of(const ReplayResult& r, io::EventKind kind, const std::string& alarm) {
+  std::vector<io::Event> out;
   std::copy_if(r.events.begin(), r.events.end(), std::back_inserter(out),
-               [&](const Event& e) { return e.kind == kind && e.alarm == alarm; });
+               [&](const io::Event& e) { return e.kind == kind && e.alarm == alarm; });
   return out;
 }
 
 TEST(SensorFaultReplay, FrozenP1IsNamedNotMistakenForALeakAndNothingIsRelearned) {
   for (auto [preset, seed] : {std::pair{"healthy", 11u}, std::pair{"healthy-ft", 12u}}) {
     SCOPED_TRACE(preset);
-    const io::Capture clean = capture(seed, preset, 300.0, kLeakOnset);
-    io::Capture frozen = clean;
+    const capture::Capture clean = capture(seed, preset, 300.0, kLeakOnset);
+    capture::Capture frozen = clean;
     freeze(frozen, "p1", kFreezeFrom, kFreezeTo);
 
     const ReplayResult result = replay_capture(frozen, default_replay_config(frozen));
-    const auto faults = events_of(result, EventKind::alarm_raised, "sensor_fault");
+    const auto faults = events_of(result, io::EventKind::alarm_raised, "sensor_fault");
     ASSERT_EQ(faults.size(), 1u);
     EXPECT_EQ(faults[0].channel, "p1");
     EXPECT_EQ(faults[0].fault, "frozen");
@@ -71,18 +71,18 @@ TEST(SensorFaultReplay, FrozenP1IsNamedNotMistakenForALeakAndNothingIsRelearned)
     EXPECT_NE(line.find("\"alarm\": \"sensor_fault\""), std::string::npos) << line;
     EXPECT_NE(line.find("\"channel\": \"p1\""), std::string::npos) << line;
     EXPECT_NE(line.find("\"fault\": \"frozen\""), std::string::npos) << line;
-    const auto cleared = events_of(result, EventKind::alarm_cleared, "sensor_fault");
+    const auto cleared = events_of(result, io::EventKind::alarm_cleared, "sensor_fault");
     ASSERT_EQ(cleared.size(), 1u);
     EXPECT_GE(cleared[0].t, kFreezeTo);
     EXPECT_LE(cleared[0].t, kFreezeTo + 5.0);
 
-    const auto leaks = events_of(result, EventKind::alarm_raised, "internal_leakage");
+    const auto leaks = events_of(result, io::EventKind::alarm_raised, "internal_leakage");
     ASSERT_FALSE(leaks.empty()) << "the leak after the fault was not found";
     EXPECT_GT(leaks.front().t, kLeakOnset) << "internal_leakage raised by the frozen sensor";
 
     // Without relearning, the leak is found about as fast as on the unfaulted capture.
     const ReplayResult reference = replay_capture(clean, default_replay_config(clean));
-    const auto reference_leaks = events_of(reference, EventKind::alarm_raised, "internal_leakage");
+    const auto reference_leaks = events_of(reference, io::EventKind::alarm_raised, "internal_leakage");
     ASSERT_FALSE(reference_leaks.empty());
     std::printf(
         "%s: sensor_fault p1 frozen after %.2f s, cleared %.2f s after recovery; leak "
@@ -103,21 +103,21 @@ TEST(SensorFaultReplay, FrozenP1IsNamedNotMistakenForALeakAndNothingIsRelearned)
 // The same frozen capture with the plausibility check of p1 switched off: what the check
 // prevents (so the test above can fail).
 TEST(SensorFaultReplay, WithoutTheCheckAFrozenP1LooksLikeALeak) {
-  const io::Capture clean = capture(11, "healthy", 160.0, std::nullopt);
-  io::Capture frozen = clean;
+  const capture::Capture clean = capture(11, "healthy", 160.0, std::nullopt);
+  capture::Capture frozen = clean;
   freeze(frozen, "p1", kFreezeFrom, kFreezeTo);
   DaemonConfig config = default_replay_config(frozen);
   config.actuators[0].p1_transducer.enabled = false;
   const ReplayResult result = replay_capture(frozen, config);
-  const auto leaks = events_of(result, EventKind::alarm_raised, "internal_leakage");
+  const auto leaks = events_of(result, io::EventKind::alarm_raised, "internal_leakage");
   ASSERT_FALSE(leaks.empty());
   EXPECT_GE(leaks.front().t, kFreezeFrom);
-  EXPECT_TRUE(events_of(result, EventKind::alarm_raised, "sensor_fault").empty());
+  EXPECT_TRUE(events_of(result, io::EventKind::alarm_raised, "sensor_fault").empty());
 }
 
 TEST(SensorFaultReplay, SingleSpikesNeitherAlarmNorChangeTheLeakDecision) {
-  const io::Capture clean = capture(13, "healthy", 240.0, kLeakOnset - 60.0);
-  io::Capture spiky = clean;
+  const capture::Capture clean = capture(13, "healthy", 240.0, kLeakOnset - 60.0);
+  capture::Capture spiky = clean;
   auto& p1 = spiky.column("p1");
   // One 3 MPa spike every 75 s: never two in a minute.
   std::size_t spikes = 0;
@@ -125,9 +125,9 @@ TEST(SensorFaultReplay, SingleSpikesNeitherAlarmNorChangeTheLeakDecision) {
 
   const ReplayResult a = replay_capture(clean, default_replay_config(clean));
   const ReplayResult b = replay_capture(spiky, default_replay_config(spiky));
-  EXPECT_TRUE(events_of(b, EventKind::alarm_raised, "sensor_fault").empty());
-  const auto leaks_a = events_of(a, EventKind::alarm_raised, "internal_leakage");
-  const auto leaks_b = events_of(b, EventKind::alarm_raised, "internal_leakage");
+  EXPECT_TRUE(events_of(b, io::EventKind::alarm_raised, "sensor_fault").empty());
+  const auto leaks_a = events_of(a, io::EventKind::alarm_raised, "internal_leakage");
+  const auto leaks_b = events_of(b, io::EventKind::alarm_raised, "internal_leakage");
   ASSERT_FALSE(leaks_a.empty());
   ASSERT_EQ(leaks_b.size(), leaks_a.size());
   EXPECT_NEAR(leaks_b.front().t, leaks_a.front().t, 0.5);
@@ -141,7 +141,7 @@ TEST(SensorFaultReplay, SingleSpikesNeitherAlarmNorChangeTheLeakDecision) {
 }
 
 TEST(SensorFaultMonitor, PerSamplePathAllocatesNothing) {
-  io::Capture c = capture(14, "healthy", 40.0, std::nullopt);
+  capture::Capture c = capture(14, "healthy", 40.0, std::nullopt);
   auto& p1 = c.column("p1");
   p1[row_at(25.0)] += 3e6;  // a rejected spike inside the measured stretch
   const DaemonConfig config = default_replay_config(c);
@@ -157,7 +157,7 @@ TEST(SensorFaultMonitor, PerSamplePathAllocatesNothing) {
   }
   ActuatorMonitor monitor(actuator, layout, 2'000'000);
   std::size_t events = 0;
-  const EventPublisher publish = [&](const Event&) { ++events; };
+  const EventPublisher publish = [&](const io::Event&) { ++events; };
   auto push_rows = [&](std::size_t from, std::size_t to) {
     std::size_t decisions = 0;
     Sample sample;

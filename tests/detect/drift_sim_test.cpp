@@ -21,7 +21,7 @@ struct Outcome {
 };
 
 Outcome run(const sim::Scenario& scenario, bool use_temp, bool use_ps, double onset) {
-  const io::Capture capture = sim::simulate(scenario);
+  const capture::Capture capture = sim::simulate(scenario);
   FlowBalanceDetector detector(FlowBalanceOptions{}, kHop);
   const auto& t = capture.column("t");
   const auto& u = capture.column("u");

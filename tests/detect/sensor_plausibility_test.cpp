@@ -31,7 +31,7 @@ TransducerSpec spec_of(const std::string& channel) {
   return channel == "x" ? TransducerSpec::position() : TransducerSpec::pressure();
 }
 
-io::Capture healthy(std::string_view preset, std::uint64_t seed, double duration) {
+capture::Capture healthy(std::string_view preset, std::uint64_t seed, double duration) {
   sim::Scenario scenario = sim::preset(preset, seed);
   scenario.duration_s = duration;
   scenario.effects.internal_leakage.reset();
@@ -49,7 +49,7 @@ struct Trace {
   std::vector<SensorFault> final_fault;
 };
 
-Trace run(const io::Capture& capture) {
+Trace run(const capture::Capture& capture) {
   Trace trace;
   for (const auto& name : kChannels) {
     const auto& values = capture.column(name);
@@ -109,7 +109,7 @@ TEST(SensorPlausibility, NoFaultOnLongHealthyRunsOfBothControllers) {
   long faulty = 0;
   std::uint64_t spikes = 0;
   for (auto [preset, seed] : {std::pair{"healthy", 21u}, std::pair{"healthy-ft", 22u}}) {
-    const io::Capture capture = healthy(preset, seed, 600.0);
+    const capture::Capture capture = healthy(preset, seed, 600.0);
     const Trace trace = run(capture);
     seconds += static_cast<double>(capture.rows()) / kRate;
     for (std::size_t c = 0; c < kChannels.size(); ++c) {
@@ -191,10 +191,10 @@ TEST(SensorPlausibility, EachFaultNamedOnItsChannelWithinFiveSeconds) {
   constexpr double kOnset = 30.0;
   const std::size_t onset = static_cast<std::size_t>(kOnset * kRate);
   for (auto [preset, seed] : {std::pair{"healthy", 31u}, std::pair{"healthy-ft", 32u}}) {
-    const io::Capture clean = healthy(preset, seed, 80.0);
+    const capture::Capture clean = healthy(preset, seed, 80.0);
     for (const auto& corruption : corruptions()) {
       SCOPED_TRACE(std::string(preset) + ": " + corruption.what);
-      io::Capture capture = clean;
+      capture::Capture capture = clean;
       corruption.apply(capture.column(corruption.channel), onset);
       const Trace trace = run(capture);
       for (std::size_t c = 0; c < kChannels.size(); ++c) {
@@ -224,8 +224,8 @@ TEST(SensorPlausibility, EachFaultNamedOnItsChannelWithinFiveSeconds) {
 }
 
 TEST(SensorPlausibility, SingleSpikesAreReplacedWithoutAFault) {
-  io::Capture capture = healthy("healthy", 41, 120.0);
-  const io::Capture clean = capture;
+  capture::Capture capture = healthy("healthy", 41, 120.0);
+  const capture::Capture clean = capture;
   auto& p1 = capture.column("p1");
   // One spike every 70 s: isolated, never two within a minute.
   const std::vector<std::size_t> at = {10'000, 45'000};
@@ -248,7 +248,7 @@ TEST(SensorPlausibility, SingleSpikesAreReplacedWithoutAFault) {
 }
 
 TEST(SensorPlausibility, RecoversThroughMaintenanceRequiredToOk) {
-  io::Capture capture = healthy("healthy", 51, 60.0);
+  capture::Capture capture = healthy("healthy", 51, 60.0);
   auto& p1 = capture.column("p1");
   const std::size_t from = 10'000, to = 15'000;  // frozen 20 s .. 30 s
   for (std::size_t i = from; i < to; ++i) p1[i] = p1[from - 1];
@@ -279,7 +279,7 @@ TEST(SensorPlausibility, RecoversThroughMaintenanceRequiredToOk) {
 }
 
 TEST(SensorPlausibility, PushAllocatesNothing) {
-  const io::Capture capture = healthy("healthy", 61, 10.0);
+  const capture::Capture capture = healthy("healthy", 61, 10.0);
   auto p1 = capture.column("p1");
   p1[2000] += 4e6;  // a spike, so the rejection path runs too
   SensorPlausibility check(TransducerSpec::pressure(), kRate);
@@ -314,7 +314,7 @@ TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
                  : std::vector{SensorFault::frozen, SensorFault::spikes, SensorFault::dropout};
     const SensorFault kind = kinds[random() % kinds.size()];
     const double onset_s = std::uniform_real_distribution<double>(10.0, 30.0)(random);
-    io::Capture capture = healthy(ft ? "healthy-ft" : "healthy", random() % 1000000, 60.0);
+    capture::Capture capture = healthy(ft ? "healthy-ft" : "healthy", random() % 1000000, 60.0);
     auto& v = capture.column(channel);
     const auto onset = static_cast<std::size_t>(onset_s * kRate);
     double recognisable_s = onset_s;

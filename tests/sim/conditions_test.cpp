@@ -62,7 +62,7 @@ Scenario every_effect(double duration_s) {
   return s;
 }
 
-void expect_identical(const io::Capture& a, const io::Capture& b) {
+void expect_identical(const capture::Capture& a, const capture::Capture& b) {
   ASSERT_EQ(a.columns, b.columns);
   ASSERT_EQ(a.rows(), b.rows());
   for (std::size_t c = 0; c < a.columns.size(); ++c) {
@@ -74,7 +74,7 @@ void expect_identical(const io::Capture& a, const io::Capture& b) {
 
 TEST(Conditions, AtFortyDegreesEveryTrajectoryIsBitIdentical) {
   for (Scenario s : {preset("paper-fig10", 3), every_effect(3.0)}) {
-    const io::Capture stationary = simulate(s);
+    const capture::Capture stationary = simulate(s);
     s.conditions.temperature = TemperatureProfile{};  // constant 40 degC
     s.conditions.supply = {{0.5, s.params.ps, 0.0}};  // a "change" to the same set-point
     ASSERT_TRUE(s.conditions.any());

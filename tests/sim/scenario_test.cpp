@@ -32,7 +32,7 @@ TEST(ScenarioFiles, EveryExampleLoadsAndRuns) {
     EXPECT_FALSE(s.name.empty());
     EXPECT_NE(s.origin.find(entry.path().filename().string()), std::string::npos);
     s.duration_s = 1.0;
-    const io::Capture capture = simulate(s);
+    const capture::Capture capture = simulate(s);
     EXPECT_EQ(capture.rows(), 500u) << entry.path();
     ++count;
   }

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "sim/rig.hpp"
 #include "sim/simulate.hpp"
 #include "tests/model/test_seed.hpp"
@@ -175,7 +175,7 @@ TEST(SensorFaults, CaptureShowsGapsAsEmptyFieldsAndNamesTheFault) {
   s.faults = {dropout, SensorFault{SensorFault::Kind::frozen, SensorChannel::temp, 2.0, 1.0}};
   const std::string path = test::scratch_dir("sim_sensor_faults") + "/gaps.csv";
   simulate_to_file(s, path);
-  const io::Capture capture = io::read_capture(path);
+  const capture::Capture capture = capture::read_capture(path);
   EXPECT_EQ(capture.columns,
             (std::vector<std::string>{"t", "xref", "u", "x", "p1", "p2", "q_int", "ps", "temp"}));
   const auto& p2 = capture.column("p2");

@@ -8,7 +8,7 @@
 #include <random>
 #include <variant>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_runner.hpp"
 #include "study/evaluation_summary.hpp"

@@ -1,7 +1,8 @@
 // What the daemon tells the outside world: alarm transitions, driver faults, overruns, reloads.
 // The worker thread builds one Event per occurrence and hands it to every EventSink (JSON-lines
-// event log, spdlog, and the configured `outputs:` such as a Modbus coil). Header-only, so that
-// output plug-ins in other folders can implement EventSink without linking the daemon.
+// event log, spdlog, and the configured `outputs:` such as a Modbus coil). The sink is the
+// output plug-in point, beside the driver interface (io/driver.hpp); header-only, so that
+// outputs implement it without linking the daemon.
 #pragma once
 
 #include <cmath>
@@ -9,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-namespace leakmon::daemon {
+namespace leakmon::io {
 
 enum class EventKind {
   alarm_raised,
@@ -86,4 +87,4 @@ class EventSink {
   virtual void flush() {}
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::io

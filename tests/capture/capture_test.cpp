@@ -1,4 +1,4 @@
-// The capture CSV reader and writer (io/capture): exact round trip, gaps, errors naming
+// The capture CSV reader and writer (capture/): exact round trip, gaps, errors naming
 // file:line:column, non-increasing time, missing header, unknown columns kept.
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <random>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/support/paths.hpp"
 
-namespace leakmon::io {
+namespace leakmon::capture {
 namespace {
 
 std::string write_file(const std::string& dir, const std::string& name, const std::string& text) {
@@ -187,4 +187,4 @@ TEST(Capture, WriterNeedsATimeColumn) {
 }
 
 }  // namespace
-}  // namespace leakmon::io
+}  // namespace leakmon::capture

@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-namespace leakmon::io {
+namespace leakmon::capture {
 
 class CaptureError : public std::runtime_error {
  public:
@@ -62,8 +62,8 @@ class CaptureReader {
 struct Capture {
   std::string path;
   Metadata metadata;
-  std::vector<std::string> columns;          // header order, includes "t"
-  std::vector<std::vector<double>> values;   // values[c][row]
+  std::vector<std::string> columns;         // header order, includes "t"
+  std::vector<std::vector<double>> values;  // values[c][row]
 
   std::size_t rows() const { return values.empty() ? 0 : values.front().size(); }
   bool has(std::string_view name) const;
@@ -107,4 +107,4 @@ void write_capture(const std::string& path, const Capture& capture);
 // Appends `value` to `out` in the capture format's number form (shortest round-trip; NaN empty).
 void append_number(std::string& out, double value);
 
-}  // namespace leakmon::io
+}  // namespace leakmon::capture

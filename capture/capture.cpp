@@ -1,4 +1,4 @@
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <charconv>
 #include <cmath>
 
-namespace leakmon::io {
+namespace leakmon::capture {
 namespace {
 
 std::string_view trim(std::string_view s) {
@@ -244,4 +244,4 @@ void write_capture(const std::string& path, const Capture& capture) {
   writer.close();
 }
 
-}  // namespace leakmon::io
+}  // namespace leakmon::capture

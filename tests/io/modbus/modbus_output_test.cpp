@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/event.hpp"
+#include "io/event.hpp"
 #include "io/modbus/modbus_driver.hpp"
 #include "io/modbus/modbus_output.hpp"
 #include "tests/io/modbus/peer_process.hpp"
@@ -18,7 +18,7 @@
 namespace leakmon::test {
 namespace {
 
-std::unique_ptr<daemon::EventSink> make_output(int port, const std::string& fields) {
+std::unique_ptr<io::EventSink> make_output(int port, const std::string& fields) {
   const std::string yaml =
       "name: plc\ntype: modbus\nhost: 127.0.0.1\nport: " + std::to_string(port) +
       "\ntimeout_ms: 100\nreconnect_min_ms: 20\nreconnect_max_ms: 200\n" + fields;
@@ -50,9 +50,9 @@ bool reads(io::Driver& reader, std::size_t index, double want) {
   return false;
 }
 
-daemon::Event alarm(daemon::EventKind kind, const std::string& actuator,
-                    const std::string& name = "internal_leakage") {
-  daemon::Event event;
+io::Event alarm(io::EventKind kind, const std::string& actuator,
+                const std::string& name = "internal_leakage") {
+  io::Event event;
   event.kind = kind;
   event.actuator = actuator;
   event.alarm = name;
@@ -72,9 +72,9 @@ TEST(ModbusOutput, CoilFollowsTheAlarm) {
   auto reader = make_reader(server.port());
   auto output = make_output(server.port(), "register: coil\naddress: 20\n");
   ASSERT_TRUE(reads(*reader, 0, 0.0));
-  output->publish(alarm(daemon::EventKind::alarm_raised, "cyl1"));
+  output->publish(alarm(io::EventKind::alarm_raised, "cyl1"));
   EXPECT_TRUE(reads(*reader, 0, 1.0));
-  output->publish(alarm(daemon::EventKind::alarm_cleared, "cyl1"));
+  output->publish(alarm(io::EventKind::alarm_cleared, "cyl1"));
   EXPECT_TRUE(reads(*reader, 0, 0.0));
 }
 
@@ -88,14 +88,14 @@ TEST(ModbusOutput, RegisterHoldsRaisedWhileAnyMatchingAlarmIsActive) {
   ASSERT_TRUE(reads(*reader, 1, 0.0));
   output->flush();  // the first flush writes the cleared state: the PLC learns "no alarm"
   EXPECT_TRUE(reads(*reader, 1, -1.0));
-  output->publish(alarm(daemon::EventKind::alarm_raised, "cyl1"));
-  output->publish(alarm(daemon::EventKind::alarm_raised, "cyl2"));
+  output->publish(alarm(io::EventKind::alarm_raised, "cyl1"));
+  output->publish(alarm(io::EventKind::alarm_raised, "cyl2"));
   EXPECT_TRUE(reads(*reader, 1, 2.0));
-  output->publish(alarm(daemon::EventKind::alarm_cleared, "cyl1"));
-  output->publish(alarm(daemon::EventKind::alarm_cleared, "cyl2", "other_alarm"));  // ignored
+  output->publish(alarm(io::EventKind::alarm_cleared, "cyl1"));
+  output->publish(alarm(io::EventKind::alarm_cleared, "cyl2", "other_alarm"));  // ignored
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_TRUE(reads(*reader, 1, 2.0));
-  output->publish(alarm(daemon::EventKind::alarm_cleared, "cyl2"));
+  output->publish(alarm(io::EventKind::alarm_cleared, "cyl2"));
   EXPECT_TRUE(reads(*reader, 1, -1.0));
 }
 
@@ -104,7 +104,7 @@ TEST(ModbusOutput, RestartedPlcLearnsTheStateAgain) {
   auto server = std::make_unique<ModbusServer>(server_options(dir));
   const int port = server->port();
   auto output = make_output(port, "register: coil\naddress: 20\nrefresh_ms: 100\n");
-  output->publish(alarm(daemon::EventKind::alarm_raised, "cyl1"));
+  output->publish(alarm(io::EventKind::alarm_raised, "cyl1"));
   {
     auto reader = make_reader(port);
     ASSERT_TRUE(reads(*reader, 0, 1.0));

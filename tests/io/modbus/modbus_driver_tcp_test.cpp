@@ -61,7 +61,8 @@ TEST_F(ModbusTcp, SamplesEqualTheServedCaptureAfterScaling) {
   // Most ticks see fresh values; the rest are gaps, never stale or wrong numbers.
   EXPECT_GT(tally.fresh, tally.ticks / 4);
   const auto health = driver->health();
-  EXPECT_EQ(health.state, "ok");
+  EXPECT_EQ(health.detail, "ok");
+  EXPECT_EQ(health.status, io::DeviceStatus::ok);
   EXPECT_EQ(health.reconnects, 0U);
   driver->stop();
   driver->stop();  // idempotent
@@ -83,7 +84,8 @@ TEST_F(ModbusTcp, ServerKilledAndRestartedGivesGapsThenRecovers) {
   EXPECT_EQ(outage.values_after_deadline, 0U);
   EXPECT_GT(outage.gaps, outage.ticks / 2);
   auto health = driver->health();
-  EXPECT_EQ(health.state, "disconnected");
+  EXPECT_EQ(health.detail, "disconnected");
+  EXPECT_EQ(health.status, io::DeviceStatus::failure);
   EXPECT_GT(health.errors, 0U);
   EXPECT_GT(health.stale_values, 0U);
 
@@ -96,7 +98,8 @@ TEST_F(ModbusTcp, ServerKilledAndRestartedGivesGapsThenRecovers) {
       << settled.first_mismatch;
   EXPECT_GT(settled.fresh, 0U);
   health = driver->health();
-  EXPECT_EQ(health.state, "ok");
+  EXPECT_EQ(health.detail, "ok");
+  EXPECT_EQ(health.status, io::DeviceStatus::ok);
   EXPECT_GE(health.reconnects, 1U);
 }
 
@@ -114,7 +117,8 @@ TEST_F(ModbusTcp, SlowServerTimesOutReconnectsAndNeverMixesUpAnswers) {
   const auto slow = capture_.run(*driver, 1.0, slowed_ns + 100'000'000);
   EXPECT_EQ(slow.values_after_deadline, 0U);
   const auto health = driver->health();
-  EXPECT_NE(health.state, "ok");
+  EXPECT_NE(health.detail, "ok");
+  EXPECT_NE(health.status, io::DeviceStatus::ok);
   EXPECT_GT(health.errors, errors_before);
   EXPECT_NE(health.last_error.find("timeout"), std::string::npos) << health.last_error;
 
@@ -141,7 +145,8 @@ TEST_F(ModbusTcp, ExceptionRepliesGiveGapsAndKeepTheConnection) {
   const auto refused = capture_.run(*driver, 0.5, refused_ns + 50'000'000);
   EXPECT_EQ(refused.values_after_deadline, 0U);
   auto health = driver->health();
-  EXPECT_EQ(health.state, "degraded");
+  EXPECT_EQ(health.detail, "degraded");
+  EXPECT_EQ(health.status, io::DeviceStatus::maintenance_required);
   EXPECT_EQ(health.reconnects, 0U);
   EXPECT_NE(health.last_error.find("exception"), std::string::npos) << health.last_error;
   const auto errors = health.errors;
@@ -153,7 +158,8 @@ TEST_F(ModbusTcp, ExceptionRepliesGiveGapsAndKeepTheConnection) {
   EXPECT_EQ(before.mismatches + refused.mismatches + after.mismatches, 0U)
       << before.first_mismatch << refused.first_mismatch << after.first_mismatch;
   health = driver->health();
-  EXPECT_EQ(health.state, "ok");
+  EXPECT_EQ(health.detail, "ok");
+  EXPECT_EQ(health.status, io::DeviceStatus::ok);
   EXPECT_EQ(health.reconnects, 0U);
 }
 
@@ -169,7 +175,8 @@ TEST_F(ModbusTcp, GarbageAnswersNeverBecomeValues) {
   EXPECT_EQ(tally.mismatches, 0U);
   const auto health = driver->health();
   EXPECT_GT(health.errors, 0U);
-  EXPECT_NE(health.state, "ok");
+  EXPECT_NE(health.detail, "ok");
+  EXPECT_NE(health.status, io::DeviceStatus::ok);
 }
 
 TEST_F(ModbusTcp, NobodyListeningBacksOffAndReportsDisconnected) {
@@ -183,7 +190,8 @@ TEST_F(ModbusTcp, NobodyListeningBacksOffAndReportsDisconnected) {
   const auto tally = capture_.run(*driver, 1.0);
   EXPECT_EQ(tally.fresh, 0U);
   const auto health = driver->health();
-  EXPECT_EQ(health.state, "disconnected");
+  EXPECT_EQ(health.detail, "disconnected");
+  EXPECT_EQ(health.status, io::DeviceStatus::failure);
   EXPECT_GE(health.errors, 1U);
   // Backoff 50, 100, 200, 400, 500 ms...: a handful of attempts a second, not hundreds.
   EXPECT_LE(health.errors, 12U);

@@ -35,7 +35,8 @@ TEST(ModbusRtu, SamplesEqualTheServedCaptureOverAPseudoTerminal) {
       << warmup.first_mismatch << tally.first_mismatch;
   EXPECT_EQ(tally.allocations, 0U);
   EXPECT_GT(tally.fresh, 0U);
-  EXPECT_EQ(driver->health().state, "ok");
+  EXPECT_EQ(driver->health().detail, "ok");
+  EXPECT_EQ(driver->health().status, io::DeviceStatus::ok);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <thread>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/io/modbus/peer_process.hpp"
 #include "tests/support/paths.hpp"
 
@@ -39,7 +39,7 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotAlarmsAndTheRecordingEqualsTheServedCaptu
                             .c_str()),
             0)
       << read_text(dir + "/sim.log");
-  const io::Capture capture = io::read_capture(served);
+  const capture::Capture capture = capture::read_capture(served);
 
   ModbusServerOptions options;
   options.ready_file = dir + "/ready";
@@ -111,7 +111,7 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotAlarmsAndTheRecordingEqualsTheServedCaptu
   for (const auto& entry : std::filesystem::directory_iterator(dir + "/recording"))
     files.push_back(entry.path().string());
   ASSERT_EQ(files.size(), 1U);
-  const io::Capture recorded = io::read_capture(files.front());
+  const capture::Capture recorded = capture::read_capture(files.front());
   const auto& index = recorded.column("index");
   std::size_t matched = 0;
   std::size_t gaps = 0;
