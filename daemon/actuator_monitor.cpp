@@ -109,12 +109,15 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   constexpr std::size_t kDelay = detect::SensorPlausibility::kDelay;
   double cleaned[3] = {kNaN, kNaN, kNaN};
   bool suspect = false;
+  bool all_missing = !channels_.empty();
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     auto& channel = channels_[i];
-    cleaned[i] = channel.check.push(value_at(sample, channel.index));
+    const double raw = value_at(sample, channel.index);
+    all_missing = all_missing && std::isnan(raw);
+    cleaned[i] = channel.check.push(raw);
     suspect |= channel.check.suspect();
   }
-  check_sensor_faults(sample.t, publish);
+  check_sensor_faults(sample.t, all_missing, publish);
   delay_[arrived_ % delay_.size()] = {sample.t, value_at(sample, layout_.u),
                                       value_at(sample, layout_.xref), value_at(sample, layout_.ps),
                                       value_at(sample, layout_.temp)};
@@ -154,10 +157,19 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   return true;
 }
 
-void ActuatorMonitor::check_sensor_faults(double t, const EventPublisher& publish) {
+void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPublisher& publish) {
   for (auto& channel : channels_) {
     const detect::SensorFault fault = channel.check.fault();
-    if (fault == channel.announced) continue;
+    // Every channel missing at once is the acquisition (a driver disconnected, missed cycles),
+    // not a transducer: the daemon reports it as driver_fault. The leak decision is held all
+    // the same; only a transducer's own dropout is a sensor_fault. A dropout that began in an
+    // outage stays unannounced until it has cleared.
+    if (fault != detect::SensorFault::dropout) channel.in_outage = false;
+    if (outage && fault == detect::SensorFault::dropout &&
+        channel.announced == detect::SensorFault::none) {
+      channel.in_outage = true;
+    }
+    if (channel.in_outage || fault == channel.announced) continue;
     io::Event event;
     event.t = t;
     event.actuator = config_.name;

@@ -52,7 +52,8 @@ struct ActuatorStatus {
   double index_p2 = io::kNoValue;
   double score = io::kNoValue;
   double baseline = io::kNoValue;
-  double leak_coefficient = io::kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
+  double leak_coefficient =
+      io::kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
   double leak_coefficient_ci = io::kNoValue;  // its 95 % half-width
   double oil_temperature = io::kNoValue;      // degC, newest hop mean of the `temp` channel
   std::uint64_t decisions = 0;
@@ -91,7 +92,8 @@ class ActuatorMonitor {
  private:
   void decide(double t, const EventPublisher& publish);
   io::Event alarm_event(io::EventKind kind, double t) const;
-  void check_sensor_faults(double t, const EventPublisher& publish);
+  // outage: every checked channel's raw value is missing in this sample.
+  void check_sensor_faults(double t, bool outage, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
 
   ActuatorConfig config_;
@@ -123,6 +125,7 @@ class ActuatorMonitor {
     int index;
     detect::SensorPlausibility check;
     detect::SensorFault announced = detect::SensorFault::none;
+    bool in_outage = false;  // its dropout began with every channel missing (not announced)
   };
   std::vector<Channel> channels_;
   double sample_rate_hz_;

@@ -171,16 +171,20 @@ std::string Daemon::metrics_text() const {
   // FORMATS.md "Operator view and fleet": the leak size in l/min/MPa (at 40 degC where the oil
   // temperature is acquired), NaN until the detector has one; its 95 % half-width beside it.
   constexpr double kLpmPerMpa = 60000.0 * 1e6;
-  out.family("leakmon_leak_lpm_per_mpa", "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel", "gauge");
+  out.family("leakmon_leak_lpm_per_mpa",
+             "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel", "gauge");
   for (const auto& a : actuators) {
-    out.sample("leakmon_leak_lpm_per_mpa", label("actuator", a.name), a.leak_coefficient * kLpmPerMpa);
+    out.sample("leakmon_leak_lpm_per_mpa", label("actuator", a.name),
+               a.leak_coefficient * kLpmPerMpa);
   }
-  out.family("leakmon_leak_lpm_per_mpa_ci95", "95 % half-width of the leak size [l/min/MPa]", "gauge");
+  out.family("leakmon_leak_lpm_per_mpa_ci95", "95 % half-width of the leak size [l/min/MPa]",
+             "gauge");
   for (const auto& a : actuators) {
     out.sample("leakmon_leak_lpm_per_mpa_ci95", label("actuator", a.name),
                a.leak_coefficient_ci * kLpmPerMpa);
   }
-  out.family("leakmon_oil_temperature_celsius", "oil temperature (hop mean of the temp channel)", "gauge");
+  out.family("leakmon_oil_temperature_celsius", "oil temperature (hop mean of the temp channel)",
+             "gauge");
   for (const auto& a : actuators) {
     if (std::isfinite(a.oil_temperature)) {
       out.sample("leakmon_oil_temperature_celsius", label("actuator", a.name), a.oil_temperature);

@@ -25,7 +25,7 @@ constexpr double kRate = 500.0;
 constexpr double kFreezeFrom = 120.0, kFreezeTo = 150.0, kLeakOnset = 210.0;
 
 capture::Capture capture(std::uint64_t seed, std::string_view preset, double duration,
-                    std::optional<double> leak_onset) {
+                         std::optional<double> leak_onset) {
   sim::Scenario scenario = sim::preset(preset, seed);
   scenario.duration_s = duration;
   scenario.effects.internal_leakage.reset();
@@ -46,7 +46,8 @@ void freeze(capture::Capture& c, const std::string& channel, double from, double
     v[i] = v[row_at(from) - 1];
 }
 
-std::vector<io::Event> events_of(const ReplayResult& r, io::EventKind kind, const std::string& alarm) {
+std::vector<io::Event> events_of(const ReplayResult& r, io::EventKind kind,
+                                 const std::string& alarm) {
   std::vector<io::Event> out;
   std::copy_if(r.events.begin(), r.events.end(), std::back_inserter(out),
                [&](const io::Event& e) { return e.kind == kind && e.alarm == alarm; });
@@ -82,7 +83,8 @@ TEST(SensorFaultReplay, FrozenP1IsNamedNotMistakenForALeakAndNothingIsRelearned)
 
     // Without relearning, the leak is found about as fast as on the unfaulted capture.
     const ReplayResult reference = replay_capture(clean, default_replay_config(clean));
-    const auto reference_leaks = events_of(reference, io::EventKind::alarm_raised, "internal_leakage");
+    const auto reference_leaks =
+        events_of(reference, io::EventKind::alarm_raised, "internal_leakage");
     ASSERT_FALSE(reference_leaks.empty());
     std::printf(
         "%s: sensor_fault p1 frozen after %.2f s, cleared %.2f s after recovery; leak "
@@ -113,6 +115,31 @@ TEST(SensorFaultReplay, WithoutTheCheckAFrozenP1LooksLikeALeak) {
   ASSERT_FALSE(leaks.empty());
   EXPECT_GE(leaks.front().t, kFreezeFrom);
   EXPECT_TRUE(events_of(result, io::EventKind::alarm_raised, "sensor_fault").empty());
+}
+
+// A gap in every channel at once is the acquisition (a driver reconnecting), reported as
+// driver_fault by the daemon, not a transducer; one channel missing alone is a dropout.
+TEST(SensorFaultReplay, AnOutageOfEveryChannelIsNotASensorFaultButOneMissingChannelIs) {
+  const capture::Capture clean = capture(14, "healthy", 160.0, std::nullopt);
+  capture::Capture outage = clean;
+  for (const char* name : {"p1", "p2", "x", "u"}) {
+    auto& v = outage.column(name);
+    for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) v[i] = NAN;
+  }
+  const ReplayResult all = replay_capture(outage, default_replay_config(outage));
+  EXPECT_TRUE(events_of(all, io::EventKind::alarm_raised, "sensor_fault").empty());
+  EXPECT_TRUE(events_of(all, io::EventKind::alarm_raised, "internal_leakage").empty());
+
+  capture::Capture one = clean;
+  auto& p2 = one.column("p2");
+  for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) p2[i] = NAN;
+  const ReplayResult single = replay_capture(one, default_replay_config(one));
+  const auto faults = events_of(single, io::EventKind::alarm_raised, "sensor_fault");
+  ASSERT_EQ(faults.size(), 1u);
+  EXPECT_EQ(faults.front().channel, "p2");
+  EXPECT_EQ(faults.front().fault, "dropout");
+  EXPECT_LT(faults.front().t, 125.0);
+  EXPECT_TRUE(events_of(single, io::EventKind::alarm_raised, "internal_leakage").empty());
 }
 
 TEST(SensorFaultReplay, SingleSpikesNeitherAlarmNorChangeTheLeakDecision) {
