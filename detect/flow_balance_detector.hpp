@@ -50,6 +50,8 @@ class FlowBalanceDetector final : public Detector {
   double raise_threshold() const override { return 1.0; }
   double clear_threshold() const override { return 0.5; }
   void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
 
  private:
   struct Hop {
