@@ -148,7 +148,8 @@ void JsonlEventLog::flush() { std::fflush(file_); }
 void LogEventSink::publish(const Event& event) {
   const auto level =
       (event.kind == EventKind::alarm_raised || event.kind == EventKind::driver_fault ||
-       event.kind == EventKind::overrun || event.kind == EventKind::config_rejected)
+       event.kind == EventKind::overrun || event.kind == EventKind::config_rejected ||
+       event.kind == EventKind::state_discarded || event.kind == EventKind::state_save_failed)
           ? spdlog::level::warn
           : spdlog::level::info;
   spdlog::log(level, "{}", to_log_line(event));
