@@ -147,5 +147,32 @@ TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
   EXPECT_FALSE(fs::exists(file));
 }
 
+// A rig that may already leak at installation: learn from a known-good capture instead.
+TEST(DaemonStateProcess, LearnFromAKnownGoodCapture) {
+  const std::string dir = test::scratch_dir("daemon_state_learn");
+  fs::remove_all(dir + "/state");
+  std::ofstream(dir + "/leakmon.yaml") << config_text(free_port(), 400);
+  write_capture(dir, 41, 24.0);
+  test::DaemonProcess learn(
+      {"learn", "--config", dir + "/leakmon.yaml", "--in", dir + "/capture.csv"},
+      dir + "/learn.log");
+  ASSERT_EQ(learn.wait(60s), 0) << learn.log();
+  EXPECT_NE(learn.log().find("actuator cyl: learned"), std::string::npos) << learn.log();
+  EXPECT_NE(show(dir).find("(learned)"), std::string::npos);
+  EXPECT_NE(show(dir).find("fits the configuration"), std::string::npos);
+
+  // Too short to learn: said so, exit status 1.
+  write_capture(dir, 42, 5.0);
+  test::DaemonProcess short_learn({"state", "learn", "--config", dir + "/leakmon.yaml", "--in",
+                                   dir + "/capture.csv", "--state-dir", dir + "/short"},
+                                  dir + "/short.log");
+  EXPECT_EQ(short_learn.wait(60s), 1) << short_learn.log();
+  EXPECT_NE(short_learn.log().find("still learning"), std::string::npos) << short_learn.log();
+
+  test::DaemonProcess help({"state", "--help"}, dir + "/help.log");
+  EXPECT_EQ(help.wait(20s), 0);
+  EXPECT_NE(help.log().find("reset"), std::string::npos) << help.log();
+}
+
 }  // namespace
 }  // namespace leakmon::daemon
