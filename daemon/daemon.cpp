@@ -494,6 +494,34 @@ std::string Daemon::metrics_text() const {
                        a.state == AlarmState::normal ? 0 : 1);
   }
   out +=
+      "# HELP leakmon_sensor_status NAMUR NE 107 status of each transducer channel (1: current)\n"
+      "# TYPE leakmon_sensor_status gauge\n";
+  std::string spikes =
+      "# HELP leakmon_sensor_spikes_rejected_total isolated spikes replaced before the index\n"
+      "# TYPE leakmon_sensor_spikes_rejected_total counter\n";
+  for (const auto& a : actuators) {
+    for (const auto& c : a.channels) {
+      for (auto status :
+           {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
+            io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
+        out += fmt::format(
+            "leakmon_sensor_status{{actuator=\"{}\",channel=\"{}\",status=\"{}\"}} {}\n",
+            label(a.name), c.channel, io::to_string(status), c.status == status ? 1 : 0);
+      }
+      spikes +=
+          fmt::format("leakmon_sensor_spikes_rejected_total{{actuator=\"{}\",channel=\"{}\"}} {}\n",
+                      label(a.name), c.channel, c.spikes_rejected);
+    }
+  }
+  out += spikes;
+  out +=
+      "# HELP leakmon_detector_suspended 1 while a faulty channel holds the leak decision\n"
+      "# TYPE leakmon_detector_suspended gauge\n";
+  for (const auto& a : actuators) {
+    out += fmt::format("leakmon_detector_suspended{{actuator=\"{}\"}} {}\n", label(a.name),
+                       a.suspended ? 1 : 0);
+  }
+  out +=
       "# HELP leakmon_driver_errors_total driver communication errors\n"
       "# TYPE leakmon_driver_errors_total counter\n";
   std::string up, reconnects, stale;
@@ -566,6 +594,13 @@ std::string Daemon::status_text() const {
         "kPa{}, detector {}, t {:.2f} s\n",
         a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score, a.baseline / 1e3,
         a.learning ? " (learning)" : "", a.detector, a.t);
+    for (const auto& c : a.channels) {
+      out += fmt::format("  channel {}: {}{}{}, {} spikes rejected\n", c.channel,
+                         io::to_string(c.status), c.fault == detect::SensorFault::none ? "" : " ",
+                         c.fault == detect::SensorFault::none ? "" : detect::to_string(c.fault),
+                         c.spikes_rejected);
+    }
+    if (a.suspended) out += "  leak decision suspended (sensor fault)\n";
   }
   return out;
 }

@@ -66,6 +66,7 @@ struct Event {
   std::string actuator;     // empty for daemon-wide events
   std::string alarm;        // "internal_leakage" for alarm events
   std::string channel;      // the index channel (e.g. "p1"), or the driver name for driver events
+  std::string fault;        // sensor_fault alarms: frozen, saturated, spikes or dropout
   double index = kNoValue;  // the index [Pa] that decided
   double score = kNoValue;  // the detector's score
   double baseline = kNoValue;  // learned healthy index [Pa]

@@ -85,6 +85,7 @@ std::string to_json_line(const Event& event) {
   json.string("actuator", event.actuator);
   json.string("alarm", event.alarm);
   json.string("channel", event.channel);
+  json.string("fault", event.fault);
   json.number("index", event.index / 1e3);
   json.number("score", event.score);
   json.number("baseline", event.baseline / 1e3);
@@ -109,6 +110,7 @@ std::string to_log_line(const Event& event) {
   if (!event.actuator.empty()) line += fmt::format(" actuator={}", event.actuator);
   if (!event.alarm.empty()) line += fmt::format(" alarm={}", event.alarm);
   if (!event.channel.empty()) line += fmt::format(" channel={}", event.channel);
+  if (!event.fault.empty()) line += fmt::format(" fault={}", event.fault);
   if (std::isfinite(event.t)) line += fmt::format(" t={:.3f}s", event.t);
   if (std::isfinite(event.index)) line += fmt::format(" index={:.2f}kPa", event.index / 1e3);
   if (std::isfinite(event.baseline)) {

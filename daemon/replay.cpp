@@ -38,7 +38,8 @@ DaemonConfig bind_to_capture(const io::Capture& capture, const DaemonConfig& con
   bound.groups = {group};
   bound.recording = {};
   for (auto& actuator : bound.actuators) {
-    for (auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+    for (auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
+                      &actuator.ps, &actuator.temp}) {
       if (!ref->present()) continue;
       ref->driver = kCaptureDriver;
       if (ref->channel == "t" || !capture.has(ref->channel)) {
@@ -67,7 +68,8 @@ DaemonConfig default_replay_config(const io::Capture& capture) {
   actuator.name = "actuator";
   for (auto [role, ref] :
        {std::pair{"p1", &actuator.p1}, std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
+        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
+        std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
     if (capture.has(role)) *ref = ChannelRef{kCaptureDriver, role, std::nullopt};
   }
   config.actuators.push_back(actuator);

@@ -36,9 +36,9 @@ struct ReplayResult {
 };
 
 // FORMATS.md built-in defaults: one actuator ("actuator") whose channels are the known columns
-// present (p1 required; p2, u, x, xref when present), index on p1 with db8 level 2, window 400,
-// step 20, symmetric, the default detector; period from the capture's sample rate. Throws
-// io::CaptureError when the capture has no p1.
+// present (p1 required; p2, u, x, xref, ps, temp when present), index on p1 with db8 level 2,
+// window 400, step 20, symmetric, the default detector; period from the capture's sample rate.
+// Throws io::CaptureError when the capture has no p1.
 DaemonConfig default_replay_config(const io::Capture& capture);
 
 // The capture replaces the configuration's drivers: actuator channels name capture columns

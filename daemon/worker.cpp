@@ -20,8 +20,8 @@ ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<Channe
     }
     return -1;
   };
-  return ChannelLayout{find(actuator.p1), find(actuator.p2), find(actuator.u), find(actuator.x),
-                       find(actuator.xref)};
+  return ChannelLayout{find(actuator.p1),   find(actuator.p2), find(actuator.u),   find(actuator.x),
+                       find(actuator.xref), find(actuator.ps), find(actuator.temp)};
 }
 
 Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
@@ -61,6 +61,7 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
         if (old && old->name() == actuator.name && old->same_pipeline(actuator, layout)) {
           kept = std::move(old);
           kept->set_alarm_settings(actuator.alarm);
+          kept->set_transducers(actuator);
           break;
         }
       }

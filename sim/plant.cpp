@@ -69,7 +69,8 @@ Plant::Plant(const Parameters& params, const Effects& effects, std::uint64_t noi
   }
   c_.droop_R_s = effects.supply_droop ? effects.supply_droop->R_s : 0.0;
   if (effects.external_leakage) {
-    c_.C_E = effects.external_leakage->C_E;
+    external_leak_ = {effects.external_leakage->C_E, effects.external_leakage->onset_s,
+                      effects.external_leakage->ramp_s};
     c_.external_chamber = effects.external_leakage->chamber;
   }
   c_.F_C = effects.coulomb_friction ? effects.coulomb_friction->F_C : 0.0;
@@ -83,7 +84,24 @@ Plant::Plant(const Parameters& params, const Effects& effects, std::uint64_t noi
     leak_ = {effects.internal_leakage->C_L, effects.internal_leakage->onset_s,
              effects.internal_leakage->ramp_s};
   }
+  set_conditions(kReferenceTemperature, params.ps);
   reset();
+}
+
+void Plant::set_conditions(double oil_temperature_C, double ps0) noexcept {
+  temperature_ = oil_temperature_C;
+  // r(40) is exactly 1 (Oil::ratio), and so are both factors: a rig at 40 degC keeps the
+  // nominal coefficients bit for bit.
+  c_.r = oil_.ratio(oil_temperature_C);
+  c_.C_n = c_.r * params_.C_n;
+  c_.b = params_.b * friction_factor(c_.r);
+  c_.beta = params_.beta * bulk_modulus_factor(oil_temperature_C);
+  c_.ps0 = ps0;
+}
+
+void Plant::set_oil(const Oil& oil) {
+  oil_ = oil;
+  set_conditions(temperature_, c_.ps0);
 }
 
 void Plant::reset() {
@@ -111,7 +129,7 @@ void Plant::set_internal_leak(double C_L, double onset_s, double ramp_s) noexcep
   leak_ = {C_L, onset_s, ramp_s};
 }
 
-PlantFlows Plant::evaluate(double t, double leak_t, double xs, double p1, double p2,
+PlantFlows Plant::evaluate(double t, double step_midpoint, double xs, double p1, double p2,
                            double w) const noexcept {
   const Parameters& p = params_;
   PlantFlows f{};
@@ -119,24 +137,27 @@ PlantFlows Plant::evaluate(double t, double leak_t, double xs, double p1, double
   f.opening = xs + w;
   if (c_.overlap > 0.0) f.opening = overlapped_opening(f.opening, c_.overlap);
 
-  f.ps = p.ps;
+  f.ps = c_.ps0;
   if (c_.ripple_dP != 0.0) f.ps += c_.ripple_dP * std::sin(c_.ripple_omega * t);
   if (c_.droop_R_s > 0.0) {
-    f.ps = drooped_supply(f.ps, c_.droop_R_s, {f.opening, p1, p2, p.pt, p.Kv, p.dp_lin, p.C_n});
+    f.ps = drooped_supply(f.ps, c_.droop_R_s, {f.opening, p1, p2, p.pt, p.Kv, p.dp_lin, c_.C_n});
   }
 
-  const ValveFlows valve = valve_flows(f.opening, f.ps, p.pt, p1, p2, p.Kv, p.dp_lin, p.C_n);
+  const ValveFlows valve = valve_flows(f.opening, f.ps, p.pt, p1, p2, p.Kv, p.dp_lin, c_.C_n);
   f.q1 = valve.q1;
   f.q2 = valve.q2;
   f.q_supply = valve.q_supply;
 
-  f.C_L = leak_.at(leak_t);
+  // Leak sizes are stated at 40 degC; the flow follows the viscosity ratio (MODEL.md). The
+  // external leak keeps its C_E: MODEL.md names C_n and C_L as the paths that scale with r.
+  f.C_L = c_.r * leak_.at(leak_.ramp_s > 0.0 ? t : step_midpoint);
   f.q_int = cross_port_flow(f.C_L, p1, p2);
-  if (c_.C_E > 0.0) {
+  if (external_leak_.C_L > 0.0) {
+    const double C_E = external_leak_.at(external_leak_.ramp_s > 0.0 ? t : step_midpoint);
     if (c_.external_chamber == 1) {
-      f.q_ext1 = external_leak_flow(c_.C_E, p1, p.pt);
+      f.q_ext1 = external_leak_flow(C_E, p1, p.pt);
     } else {
-      f.q_ext2 = external_leak_flow(c_.C_E, p2, p.pt);
+      f.q_ext2 = external_leak_flow(C_E, p2, p.pt);
     }
   }
   return f;
@@ -149,17 +170,16 @@ void Plant::rates(double t, double u, const Vector& y, Vector& dy) noexcept {
   const double p2 = std::max(y[kP2], 0.0);
   const double x = y[kX];
   const double v = y[kV];
-  const PlantFlows f =
-      evaluate(t, leak_.ramp_s > 0.0 ? t : step_midpoint_, y[kXs], p1, p2, noise_.at(t));
+  const PlantFlows f = evaluate(t, step_midpoint_, y[kXs], p1, p2, noise_.at(t));
 
   dy[kXs] = spool_rate(u + c_.u_bias, y[kXs], p.u_max, c_.tau_spool);
 
   const double V1 = std::max(c_.V0 + c_.A * x, c_.V_min);
   const double V2 = std::max(c_.V0 - c_.A * x, c_.V_min);
-  double beta1 = p.beta, beta2 = p.beta;
+  double beta1 = c_.beta, beta2 = c_.beta;
   if (c_.alpha > 0.0) {
-    beta1 = entrained_air_bulk_modulus(p.beta, c_.alpha, p1);
-    beta2 = entrained_air_bulk_modulus(p.beta, c_.alpha, p2);
+    beta1 = entrained_air_bulk_modulus(c_.beta, c_.alpha, p1);
+    beta2 = entrained_air_bulk_modulus(c_.beta, c_.alpha, p2);
   }
   const double inflow1 = f.q1 - f.q_int - f.q_ext1;
   const double inflow2 = f.q2 + f.q_int - f.q_ext2;
@@ -171,7 +191,7 @@ void Plant::rates(double t, double u, const Vector& y, Vector& dy) noexcept {
   const double friction = c_.F_C > 0.0 ? coulomb_friction(c_.F_C, v) : 0.0;
   const double stop = end_stop_force(x, v, c_.half_stroke, p.K_stop, p.c_stop);
   dy[kX] = v;
-  dy[kV] = piston_acceleration(c_.A, p1, p2, p.m, p.b, p.K_s, x, v, friction, stop);
+  dy[kV] = piston_acceleration(c_.A, p1, p2, p.m, c_.b, p.K_s, x, v, friction, stop);
 
   // Transducer lag (effect sensor_lag): tau_s dp_m/dt = p - p_m; otherwise the transducer
   // output is the chamber pressure (copied after each step).
@@ -179,8 +199,8 @@ void Plant::rates(double t, double u, const Vector& y, Vector& dy) noexcept {
   dy[kP2Transducer] = c_.lag_p2 ? (p2 - y[kP2Transducer]) / c_.lag_tau_s : 0.0;
 
   if (ledger_) {
-    dy[kMassIn1] = std::exp(y[kP1] / p.beta) * inflow1;
-    dy[kMassIn2] = std::exp(y[kP2] / p.beta) * inflow2;
+    dy[kMassIn1] = std::exp(y[kP1] / c_.beta) * inflow1;
+    dy[kMassIn2] = std::exp(y[kP2] / c_.beta) * inflow2;
   } else {
     dy[kMassIn1] = dy[kMassIn2] = 0.0;
   }
@@ -211,7 +231,8 @@ void Plant::advance(double u, double t0, double dt) noexcept {
 }
 
 double Plant::leak_flow() const {
-  return cross_port_flow(leak_.at(time_), std::max(state_.p1, 0.0), std::max(state_.p2, 0.0));
+  return cross_port_flow(c_.r * leak_.at(time_), std::max(state_.p1, 0.0),
+                         std::max(state_.p2, 0.0));
 }
 
 PlantFlows Plant::flows() const {

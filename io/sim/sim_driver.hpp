@@ -31,6 +31,9 @@ struct SimSettings {
 
 // What the rig offers, in capture column names (FORMATS.md).
 inline constexpr std::array<const char*, 6> kSimChannels = {"xref", "u", "x", "p1", "p2", "q_int"};
+// Optional transducers (supply pressure, oil temperature): offered when named in `channels`,
+// and part of the default set when the scenario records them (its `record:` list).
+inline constexpr std::array<const char*, 2> kSimOptionalChannels = {"ps", "temp"};
 
 class SimDriver final : public Driver {
  public:

@@ -93,6 +93,15 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   EXPECT_NE(metrics.find("leakmon_build_info{version="), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_ring_drops_total{group=\"main\"}"), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_loop_wakeup_latency_seconds_bucket"), std::string::npos);
+  // Each transducer channel's NE 107 status (detect/sensor_plausibility.hpp), in both texts.
+  EXPECT_NE(metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"p1\",status=\"ok\"} 1"),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(
+      metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"x\",status=\"failure\"} 0"),
+      std::string::npos);
+  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/status").body.find("channel p2: ok"),
+            std::string::npos);
 
   // A valid change applies; a broken file is rejected with its location and changes nothing.
   const std::string events = dir + "/events.jsonl";

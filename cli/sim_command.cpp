@@ -1,14 +1,16 @@
 // `leakmon sim`: runs the rig model (sim/) for a preset or a scenario file and writes the
-// capture CSV of FORMATS.md, with t,xref,u,x,p1,p2,q_int and metadata naming the origin,
-// seed, injected effects and non-nominal parameters.
+// capture CSV of FORMATS.md, with t,xref,u,x,p1,p2,q_int (plus ps and temp when recorded) and
+// metadata naming the origin, seed, injected effects, drifting conditions, sensor faults and
+// non-nominal parameters.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 
@@ -17,13 +19,19 @@ namespace leakmon::cli {
 int run_sim(int argc, char** argv) {
   ArgParser args("sim", fmt::format("Simulates the test rig of MODEL.md and writes a capture CSV.\n"
                                     "Give exactly one of --preset or --scenario. Presets: {}.\n"
-                                    "Scenario files are YAML (examples in sim/scenarios/).",
+                                    "Scenario files are YAML (examples in sim/scenarios/); they\n"
+                                    "also set oil temperature, supply set-point changes and\n"
+                                    "sensor faults (docs/simulation.md).",
                                     fmt::join(sim::preset_names(), ", ")));
   args.option("preset", "NAME", "a built-in experiment, e.g. paper-fig13", std::nullopt)
       .option("scenario", "SCENARIO.yaml", "a scenario file", std::nullopt)
       .option("out", "CAPTURE.csv", "where to write the capture", std::nullopt, true)
       .option("seed", "N", "random seed (overrides the scenario's)", std::nullopt)
       .option("duration", "SECONDS", "run length (overrides the preset's or scenario's)",
+              std::nullopt)
+      .option("record", "COLUMNS",
+              "optional columns to record as well, comma-separated: ps (supply pressure), temp "
+              "(oil temperature)",
               std::nullopt);
   if (!args.parse(argc, argv)) return 0;
 
@@ -56,6 +64,23 @@ int run_sim(int argc, char** argv) {
       throw UsageError(fmt::format("option '--duration': must be in (0, 1e6] s, got {}", duration));
     }
     scenario.duration_s = duration;
+  }
+  if (args.has("record")) {
+    const std::string list = args.get("record");
+    std::size_t begin = 0;
+    while (begin <= list.size()) {
+      const std::size_t end = std::min(list.find(',', begin), list.size());
+      const std::string column = list.substr(begin, end - begin);
+      if (column == "ps") {
+        scenario.record.ps = true;
+      } else if (column == "temp") {
+        scenario.record.temp = true;
+      } else {
+        throw UsageError(
+            fmt::format("option '--record': unknown column '{}' (allowed: ps, temp)", column));
+      }
+      begin = end + 1;
+    }
   }
   sim::simulate_to_file(scenario, args.get("out"));
   return 0;

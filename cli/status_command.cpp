@@ -1,8 +1,8 @@
 // `leakmon status` and `leakmon ack`: talk to a running daemon over its metrics endpoint.
 #include <fmt/format.h>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/http_endpoint.hpp"
 

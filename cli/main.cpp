@@ -5,8 +5,8 @@
 #include <exception>
 #include <string_view>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "model/diagnosis.hpp"
 #include "model/effect_library.hpp"
 #include "model/evaluation.hpp"

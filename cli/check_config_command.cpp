@@ -1,8 +1,8 @@
 // `leakmon check-config CONFIG.yaml`: validate without running.
 #include <fmt/format.h>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 
 namespace leakmon::cli {

@@ -4,8 +4,8 @@
 
 #include <fstream>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/replay.hpp"

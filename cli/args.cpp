@@ -1,4 +1,4 @@
-#include "daemon/cli/args.hpp"
+#include "cli/args.hpp"
 
 #include <fmt/format.h>
 

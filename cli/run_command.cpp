@@ -3,8 +3,8 @@
 
 #include <cstdlib>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/daemon.hpp"
 
 namespace leakmon::cli {

@@ -9,8 +9,8 @@
 #include <optional>
 #include <string>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/replay.hpp"
 #include "daemon/state_store.hpp"

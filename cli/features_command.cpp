@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "daemon/cli/args.hpp"
-#include "daemon/cli/subcommands.hpp"
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
 #include "dsp/block_features.hpp"
 #include "dsp/streaming_features.hpp"
 #include "io/capture/capture.hpp"
