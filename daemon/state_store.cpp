@@ -93,9 +93,9 @@ StateFingerprint state_fingerprint(const ActuatorConfig& actuator, std::int64_t 
   const std::string kind =
       actuator.detector == "default" ? detect::default_detector_kind(signals) : actuator.detector;
   fp.parts.emplace_back(
-      "channels",
-      fmt::format("p1={} p2={} u={} x={} xref={}", actuator.p1.channel, actuator.p2.channel,
-                  actuator.u.channel, actuator.x.channel, actuator.xref.channel));
+      "channels", fmt::format("p1={} p2={} u={} x={} xref={} ps={} temp={}", actuator.p1.channel,
+                              actuator.p2.channel, actuator.u.channel, actuator.x.channel,
+                              actuator.xref.channel, actuator.ps.channel, actuator.temp.channel));
   const auto& f = actuator.features;
   fp.parts.emplace_back(
       "features", fmt::format("wavelet={} level={} window={} step={} mode={}", f.wavelet, f.level,
