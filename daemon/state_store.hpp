@@ -4,8 +4,8 @@
 // holds a format version, the fingerprint of the configuration the state depends on (the
 // actuator's channels incl. ps and temp, detector kind and options, feature settings, sample
 // period), the annunciated alarm state, and the detector's state (detect/detector_state.hpp),
-// closed by a checksum. Files are replaced atomically (temporary file in the same directory, fsync, rename,
-// fsync of the directory): a crash mid-write leaves the previous file whole.
+// closed by a checksum. Files are replaced atomically (temporary file in the same directory,
+// fsync, rename, fsync of the directory): a crash mid-write leaves the previous file whole.
 #pragma once
 
 #include <cstdint>
