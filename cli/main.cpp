@@ -22,6 +22,8 @@ constexpr Subcommand kSubcommands[] = {
     {"check-config", "validate a daemon configuration without running it", leakmon::cli::run_check_config},
     {"status", "summary from the running daemon", leakmon::cli::run_status},
     {"ack", "acknowledge alarms in the running daemon", leakmon::cli::run_ack},
+    {"state", "show or reset what the daemon keeps across restarts", leakmon::cli::run_state},
+    {"learn", "learn the healthy rig from a known-good capture (state directory)", leakmon::cli::run_learn},
     {"features", "sliding-window wavelet index of one capture channel", leakmon::cli::run_features},
     {"sim", "simulate the test rig (presets paper-fig10/13/16, scenario YAML)", leakmon::cli::run_sim},
     {"evaluate", "Monte-Carlo error rates of the leak detectors", leakmon::cli::run_evaluate},

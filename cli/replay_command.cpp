@@ -22,6 +22,10 @@ int run_replay(int argc, char** argv) {
               "daemon configuration for actuators, detector and alarms (default: built-in)",
               std::string(""));
   args.flag("realtime", "pace at the capture's own rate instead of as fast as possible");
+  args.option("state-dir", "DIR",
+              "behave as a daemon restart: resume from what DIR holds for this configuration, "
+              "save there at the end",
+              std::string(""));
   if (!args.parse(argc, argv)) return 0;
 
   auto capture = std::make_shared<const capture::Capture>(capture::read_capture(args.get("in")));
@@ -30,11 +34,17 @@ int run_replay(int argc, char** argv) {
                                           : daemon::load_config(args.get("config"));
   daemon::ReplayOptions options;
   options.realtime = args.flag_set("realtime");
+  options.state_directory = args.get("state-dir");
   const auto result = daemon::replay_capture(capture, config, options);
 
   std::ofstream out(args.get("events"));
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.get("events")));
-  for (const auto& event : result.events) out << daemon::to_json_line(event) << '\n';
+  for (const auto& event : result.events) {
+    out << daemon::to_json_line(event) << '\n';
+    if (event.kind == io::EventKind::state_discarded) {
+      fmt::print(stderr, "warning: {}\n", event.message);
+    }
+  }
   out.close();
   if (!out) throw std::runtime_error(fmt::format("{}: write failed", args.get("events")));
   fmt::print(stderr, "{}: {} samples, {} events -> {}\n", args.get("in"), result.samples_processed,

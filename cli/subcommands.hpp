@@ -14,5 +14,7 @@ int run_replay(int argc, char** argv);
 int run_check_config(int argc, char** argv);
 int run_status(int argc, char** argv);
 int run_ack(int argc, char** argv);
+int run_state(int argc, char** argv);
+int run_learn(int argc, char** argv);
 
 }  // namespace leakmon::cli

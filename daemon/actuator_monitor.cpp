@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -50,6 +51,7 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       features_(config.features, layout.p2 >= 0 ? 2 : 1),
       detector_(build_detector(config, layout, period_ns)),
       alarm_(effective(config.alarm)),
+      fingerprint_(state_fingerprint(config, period_ns)),
       activity_(config.features.window, kNaN),
       index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
       sample_rate_hz_(1e9 / static_cast<double>(period_ns)) {
@@ -275,6 +277,32 @@ io::Event ActuatorMonitor::alarm_event(io::EventKind kind, double t) const {
     }
   }
   return event;
+}
+
+ActuatorState ActuatorMonitor::export_state() const {
+  ActuatorState state;
+  state.actuator = config_.name;
+  state.fingerprint = fingerprint_;
+  state.saved_unix =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  state.alarm = alarm_.state();
+  state.alarm_condition = alarm_.condition();
+  state.detector = detector_->export_state();
+  return state;
+}
+
+void ActuatorMonitor::import_state(const ActuatorState& state) {
+  try {
+    detector_->import_state(state.detector);
+  } catch (const detect::StateError&) {
+    detector_->reset();
+    throw;
+  }
+  alarm_.restore(state.alarm, state.alarm_condition);
+  detector_->resume_after_gap();
+  detect::Observation gap;
+  last_decision_ = detector_->update(gap);
+  last_decision_.score = kNaN;
 }
 
 ActuatorStatus ActuatorMonitor::status() const {

@@ -20,6 +20,7 @@
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
 #include "daemon/sample.hpp"
+#include "daemon/state_store.hpp"
 #include "detect/detector.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
@@ -89,6 +90,15 @@ class ActuatorMonitor {
 
   ActuatorStatus status() const;
 
+  // Persistence across restarts (state_store.hpp). Not for the real-time path: both allocate.
+  const StateFingerprint& fingerprint() const { return fingerprint_; }
+  ActuatorState export_state() const;
+  // Resumes from a saved state of the same fingerprint: the detector's learning and test, and
+  // the annunciated alarm. The time the daemon was down counts as one gap in the data (the
+  // detector sees one hop without values), so nothing is spliced across it. Throws
+  // detect::StateError when the detector cannot take the state; it then learns afresh.
+  void import_state(const ActuatorState& state);
+
  private:
   void decide(double t, const EventPublisher& publish);
   io::Event alarm_event(io::EventKind kind, double t) const;
@@ -101,6 +111,7 @@ class ActuatorMonitor {
   dsp::StreamingFeatures features_;
   std::unique_ptr<detect::Detector> detector_;
   Alarm alarm_;
+  StateFingerprint fingerprint_;
 
   // Hop accumulators: sums and counts of u, x, p1, p2 over the newest `step` samples.
   struct HopMean {

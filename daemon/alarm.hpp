@@ -52,6 +52,13 @@ class Alarm {
   const AlarmSettings& settings() const { return settings_; }
   // New thresholds and delays keep the current state (a reload must not drop an active alarm).
   void set_settings(const AlarmSettings& settings) { settings_ = settings; }
+  // A restart: the annunciated state and the condition come back (an unacknowledged latched
+  // alarm must still wait for its operator); the delays start over.
+  void restore(AlarmState state, bool condition) {
+    state_ = state;
+    condition_ = condition;
+    above_since_ = below_since_ = NAN;
+  }
 
  private:
   AlarmSettings settings_;

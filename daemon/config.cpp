@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
@@ -229,9 +230,18 @@ static std::string resolve_path(const config::ConfigNode& node, const std::strin
   return (std::filesystem::path(node.source()).parent_path() / path).lexically_normal().string();
 }
 
+std::string default_state_directory() {
+  // systemd passes a colon-separated list when the unit names several state directories.
+  if (const char* env = std::getenv("STATE_DIRECTORY"); env != nullptr && *env != '\0') {
+    const std::string list(env);
+    return list.substr(0, list.find(':'));
+  }
+  return "/var/lib/leakmon";
+}
+
 DaemonConfig parse_config(const config::ConfigNode& root) {
-  root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "metrics", "outputs",
-                    "worker", "realtime"});
+  root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "state", "metrics",
+                    "outputs", "worker", "realtime"});
   DaemonConfig config;
   config.source = root.source();
 
@@ -280,6 +290,12 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     config.recording.keep_files =
         static_cast<std::size_t>(recording->get_int("keep_files", 24, 0, 1000000));
     config.recording.flush_seconds = recording->get_double("flush_seconds", 1.0, 0.01, 1.0);
+  }
+  if (auto state = root.find("state")) {
+    state->expect_keys({"directory", "save_seconds"});
+    config.state.directory =
+        resolve_path(*state, state->get_string("directory", config.state.directory));
+    config.state.save_seconds = state->get_double("save_seconds", 60.0, 1.0, 86400.0);
   }
   if (auto metrics = root.find("metrics")) {
     metrics->expect_keys({"address", "port"});

@@ -66,6 +66,15 @@ struct RecordingConfig {
   double flush_seconds = 1.0;
 };
 
+// Where what was learned is kept across restarts (state_store.hpp).
+struct StateConfig {
+  std::string directory;       // empty: nothing is kept (every start learns afresh)
+  double save_seconds = 60.0;  // save at least this often, and at shutdown
+};
+
+// $STATE_DIRECTORY (set by systemd for StateDirectory=leakmon), else /var/lib/leakmon.
+std::string default_state_directory();
+
 struct MetricsConfig {
   std::string address = "127.0.0.1";
   int port = 9187;  // 0 disables the metrics and control endpoint
@@ -78,6 +87,7 @@ struct DaemonConfig {
   std::vector<ActuatorConfig> actuators;
   std::string event_log;  // JSON-lines file; empty: none
   RecordingConfig recording;
+  StateConfig state{default_state_directory(), 60.0};
   MetricsConfig metrics;
   std::vector<config::ConfigNode> outputs;
   // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency

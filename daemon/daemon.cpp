@@ -51,6 +51,7 @@ std::string acquisition_signature(const DaemonConfig& config) {
   text += fmt::format("metrics {}:{}\n", config.metrics.address, config.metrics.port);
   text += fmt::format("worker {} {}\n", config.worker_priority, config.worker_poll_ns);
   text += fmt::format("realtime {}\n", config.cpu_wakeup_latency_us);
+  text += fmt::format("state {}\n", config.state.directory);
   return text;
 }
 
@@ -124,6 +125,13 @@ void Daemon::start() {
   reported_overruns_.assign(groups_.size(), 0);
   sinks_ = build_sinks(config_);
   worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
+  // What was learned before a restart comes back before the first sample is acquired.
+  if (!config_.state.directory.empty()) {
+    state_store_ = std::make_unique<StateStore>(config_.state.directory);
+    worker_->restore_states(*state_store_);
+    spdlog::info("learned state kept under {} (saved every {} s and at shutdown)",
+                 config_.state.directory, config_.state.save_seconds);
+  }
 
   std::vector<std::string> worker_warnings;
   std::atomic<bool> worker_ready{false};
@@ -174,6 +182,23 @@ void Daemon::start() {
     spdlog::info("recording raw samples under {}", config_.recording.directory);
   }
   started_ns_ = monotonic_now_ns();
+  last_state_save_ns_ = started_ns_;
+}
+
+void Daemon::save_state() {
+  if (!state_store_ || !worker_) return;
+  for (const auto& state : worker_->export_states()) {
+    try {
+      state_store_->save(state);
+    } catch (const std::exception& e) {
+      spdlog::error("cannot save the learned state: {}", e.what());
+      io::Event event;
+      event.kind = io::EventKind::state_save_failed;
+      event.actuator = state.actuator;
+      event.message = e.what();
+      worker_->publish(event);
+    }
+  }
 }
 
 void Daemon::stop() {
@@ -186,6 +211,7 @@ void Daemon::stop() {
   stop_worker_.store(true, std::memory_order_release);
   if (worker_thread_.joinable()) worker_thread_.join();
   worker_->drain(monotonic_now_ns());  // whatever the loops pushed last
+  save_state();
   worker_->flush();
   endpoint_.reset();
   std::uint64_t pushed = 0, drops = 0;
@@ -224,6 +250,11 @@ bool Daemon::making_progress(std::int64_t now_ns) {
 }
 
 void Daemon::housekeeping(std::int64_t now_ns) {
+  if (state_store_ &&
+      now_ns - last_state_save_ns_ >= static_cast<std::int64_t>(config_.state.save_seconds * 1e9)) {
+    save_state();
+    last_state_save_ns_ = now_ns;
+  }
   // Overruns: at most one warning (and one event) per second for all groups.
   if (now_ns - last_overrun_warning_ns_ >= kSecond) {
     for (std::size_t i = 0; i < groups_.size(); ++i) {
@@ -272,7 +303,8 @@ void Daemon::reload() {
     DaemonConfig next = check_config(config_path_);
     if (acquisition_signature(next) != acquisition_signature(config_)) {
       throw config::ConfigError(fmt::format(
-          "{}: drivers, sampling groups, recording, metrics, worker or realtime changed; these "
+          "{}: drivers, sampling groups, recording, metrics, worker, realtime or state directory "
+          "changed; these "
           "need a restart "
           "(systemctl restart leakmon)",
           config_path_));

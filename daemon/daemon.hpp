@@ -18,6 +18,7 @@
 #include "daemon/cpu_latency_request.hpp"
 #include "daemon/http_endpoint.hpp"
 #include "daemon/service_notifier.hpp"
+#include "daemon/state_store.hpp"
 #include "daemon/worker.hpp"
 #include "io/driver.hpp"
 #include "io/event.hpp"
@@ -63,6 +64,9 @@ class Daemon {
   static std::vector<io::EventSink*> raw(const std::vector<std::unique_ptr<io::EventSink>>& sinks);
   void reload();
   void housekeeping(std::int64_t now_ns);
+  // Writes every actuator's learned state to the state directory (main thread; the worker is
+  // locked only for the snapshot, the files are written outside it).
+  void save_state();
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   HttpResponse handle(const HttpRequest& request);
@@ -75,6 +79,8 @@ class Daemon {
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<HttpEndpoint> endpoint_;
+  std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
+  std::int64_t last_state_save_ns_ = 0;
   CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};

@@ -4,10 +4,12 @@
 
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <thread>
 
 #include "daemon/acquisition_loop.hpp"
 #include "daemon/event_log.hpp"
+#include "daemon/state_store.hpp"
 #include "daemon/worker.hpp"
 #include "io/replay/replay_driver.hpp"
 
@@ -101,6 +103,11 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
     channels.push_back({kCaptureDriver, name, std::nullopt});
   CollectingEventSink events;
   Worker worker(bound, {GroupInput{group.name, &ring, channels, group.period_ns}}, {&events});
+  std::optional<StateStore> store;
+  if (!options.state_directory.empty()) {
+    store.emplace(options.state_directory);
+    worker.restore_states(*store);
+  }
 
   if (options.realtime) {
     std::atomic<bool> stop{false};
@@ -126,6 +133,10 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
     }
   }
   worker.drain(0);
+  std::vector<ActuatorState> learned = worker.export_states();
+  if (store) {
+    for (const auto& state : learned) store->save(state);
+  }
   worker.flush();
 
   ReplayResult result;
@@ -134,6 +145,7 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
   result.samples_processed = worker.samples_processed();
   result.ring_drops = loop.counters().ring_drops.load();
   result.actuators = worker.status();
+  result.learned = std::move(learned);
   return result;
 }
 

@@ -11,6 +11,8 @@
 #include "capture/capture.hpp"
 #include "daemon/actuator_monitor.hpp"
 #include "daemon/config.hpp"
+#include "capture/capture.hpp"
+#include "daemon/state_store.hpp"
 #include "io/event.hpp"
 
 namespace leakmon::daemon {
@@ -20,6 +22,9 @@ struct ReplayOptions {
   // dropping samples). true: paced at the capture's own rate on the real clock, loop and worker
   // on their own threads as in the daemon.
   bool realtime = false;
+  // Non-empty: behave as a daemon restart (FORMATS.md `--state-dir`): resume from what this
+  // directory holds for a compatible configuration, and save there when the capture ends.
+  std::string state_directory;
 };
 
 struct ReplayResult {
@@ -28,6 +33,7 @@ struct ReplayResult {
   std::uint64_t samples_processed = 0;    // samples the worker consumed
   std::uint64_t ring_drops = 0;           // 0 unless realtime and the worker fell behind
   std::vector<ActuatorStatus> actuators;  // state at the end
+  std::vector<ActuatorState> learned;     // what each actuator's detector learned, at the end
 };
 
 // FORMATS.md built-in defaults: one actuator ("actuator") whose channels are the known columns

@@ -1,5 +1,7 @@
 #include "daemon/worker.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -157,6 +159,45 @@ void Worker::flush() {
     if (group.recorder) group.recorder->flush();
   }
   for (auto* sink : sinks_) sink->flush();
+}
+
+std::vector<ActuatorState> Worker::export_states() const {
+  std::lock_guard lock(mutex_);
+  std::vector<ActuatorState> states;
+  for (const auto& group : groups_) {
+    for (const auto& monitor : group.monitors) states.push_back(monitor->export_state());
+  }
+  return states;
+}
+
+void Worker::restore_states(const StateStore& store) {
+  std::lock_guard lock(mutex_);
+  for (auto& group : groups_) {
+    for (auto& monitor : group.monitors) {
+      io::Event event;
+      event.actuator = monitor->name();
+      StateStore::Loaded loaded = store.load(monitor->name(), monitor->fingerprint());
+      if (loaded.state) {
+        try {
+          monitor->import_state(*loaded.state);
+          event.kind = io::EventKind::state_restored;
+          event.message =
+              fmt::format("{}: resumed what was learned (alarm {})",
+                          store.file_of(monitor->name()).string(), to_string(loaded.state->alarm));
+        } catch (const detect::StateError& e) {
+          loaded.warning = fmt::format("{}: saved state set aside: {}",
+                                       store.file_of(monitor->name()).string(), e.what());
+        }
+      }
+      if (!loaded.warning.empty()) {
+        event.kind = io::EventKind::state_discarded;
+        event.message = loaded.warning + "; learning afresh";
+      } else if (!loaded.state) {
+        continue;  // nothing saved yet: a first start
+      }
+      publish_locked(event);
+    }
+  }
 }
 
 std::vector<ActuatorStatus> Worker::status() const {

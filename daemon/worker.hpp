@@ -48,6 +48,13 @@ class Worker {
   void apply(const DaemonConfig& config, std::vector<io::EventSink*> sinks);
   void flush();
 
+  // Persistence across restarts (state_store.hpp), never from the real-time path: a snapshot of
+  // what every actuator has learned, and resuming from `store` before the first sample. Each
+  // actuator whose state was restored or set aside gets a state_restored / state_discarded
+  // event (set aside: it learns afresh).
+  std::vector<ActuatorState> export_states() const;
+  void restore_states(const StateStore& store);
+
   std::vector<ActuatorStatus> status() const;
   std::uint64_t samples_processed() const;
   std::uint64_t events_published() const;

@@ -21,6 +21,8 @@ class Cusum {
   // The statistic in units of its threshold: 1 means "raise".
   double normalised() const { return sum_ / threshold_; }
   void reset() { sum_ = 0.0; }
+  // A saved value() (a restart); clamped to the statistic's range.
+  void restore(double sum) { sum_ = std::clamp(sum, 0.0, cap_); }
 
  private:
   double threshold_;

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "detect/detector_state.hpp"
+
 namespace leakmon::detect {
 
 inline constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
@@ -60,6 +62,19 @@ class Detector {
   virtual double clear_threshold() const = 0;
   // Forget everything learned (e.g. after maintenance, on operator request).
   virtual void reset() = 0;
+  // Everything the detector has learned and where it stands in its current block and test, so
+  // that a restart resumes instead of relearning (a leak that opened while the daemon was down
+  // would otherwise be learned as healthy). A detector of the same kind and options that
+  // imports the state decides exactly as this one would have on the same following data.
+  virtual DetectorState export_state() const = 0;
+  // Throws StateError when `state` does not fit this detector (other kind or layout, sizes that
+  // do not match its options); the detector is then reset(). Not for the real-time path: it
+  // allocates.
+  virtual void import_state(const DetectorState& state) = 0;
+  // After import_state() on a restart: the data resumes after a gap of unknown length, on a
+  // source clock that may have started over. Forgets what is tied to times or to the previous
+  // hop (what was learned stays).
+  virtual void resume_after_gap() {}
 };
 
 }  // namespace leakmon::detect

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "detect/least_squares.hpp"
 
@@ -369,6 +372,178 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
         options_.valve_coefficient_uncertainty * std::abs(decision.leak_coefficient);
   }
   last_ = decision;
+}
+
+}  // namespace leakmon::detect
+
+namespace leakmon::detect {
+
+namespace {
+
+constexpr int kFlowStateVersion = 2;
+constexpr std::size_t kHopValues = 9;
+
+}  // namespace
+
+DetectorState FlowBalanceDetector::export_state() const {
+  DetectorState state(std::string(name()), kFlowStateVersion);
+  auto put_hop = [](std::vector<double>& out, const Hop& h) {
+    out.insert(out.end(), {h.t, h.opening, h.load, h.root, h.leak_term, h.speed, h.supply,
+                           h.viscosity_ratio, h.usable ? 1.0 : 0.0});
+  };
+  auto hop_values = [&](const Hop& h) {
+    std::vector<double> v;
+    put_hop(v, h);
+    return v;
+  };
+  state.put_count("observations", observations_);
+  state.put_count("hops_seen", hops_seen_);
+  state.put("previous_x", previous_x_);
+  state.put("before", hop_values(before_));
+  state.put("pending", hop_values(pending_));
+  std::vector<double> learned;
+  learned.reserve(learned_.size() * (kHopValues + 1));
+  for (const auto& rest : learned_) {
+    put_hop(learned, rest.hop);
+    learned.push_back(static_cast<double>(rest.block));
+  }
+  state.put("learned_rest_hops", learned);
+  state.put("learned_model", learned_model_ ? 1.0 : 0.0);
+  state.put("positive_loads",
+            std::vector<double>{positive_loads_.low, positive_loads_.high, positive_loads_.middle});
+  state.put("negative_loads",
+            std::vector<double>{negative_loads_.low, negative_loads_.high, negative_loads_.middle});
+  state.put("coefficients",
+            std::vector<double>(coefficients_.data(), coefficients_.data() + coefficients_.size()));
+  state.put("hop_sigma", hop_sigma_);
+  state.put("block_sigma", block_sigma_);
+  state.put_count("block_hop", block_hop_);
+  state.put_count("block_rest_hops", block_rest_hops_);
+  state.put("block_sums", std::vector<double>{block_residual_sum_, block_leak_term_sum_});
+  for (const auto& [key, sums] :
+       {std::pair{"weighted", &weighted_}, std::pair{"since_change", &since_change_},
+        std::pair{"change_block", &change_block_}}) {
+    state.put(key, std::vector<double>{sums->rl, sums->ll, sums->ll_sq});
+  }
+  state.put("cusum", cusum_.value());
+  state.put("last_decision",
+            std::vector<double>{last_.score, last_.learning ? 1.0 : 0.0, last_.baseline,
+                                last_.index, last_.leak_coefficient, last_.leak_coefficient_ci,
+                                last_.viscosity_ratio});
+  state.put("supply", std::vector<double>{supply_estimate_, supply_settled_since_});
+  state.put("temperature_seen", temperature_seen_ ? 1.0 : 0.0);
+  std::vector<double> trend;
+  trend.reserve(trend_.size() * 3);
+  for (const auto& b : trend_) trend.insert(trend.end(), {b.t, b.residual, b.leak_term});
+  state.put("trend", trend);
+  state.put_count("trend_next", trend_next_);
+  state.put_count("trend_count", trend_count_);
+  return state;
+}
+
+void FlowBalanceDetector::import_state(const DetectorState& state) {
+  reset();
+  try {
+    state.expect(name(), kFlowStateVersion);
+    auto list = [&](const char* key, std::size_t size) -> const std::vector<double>& {
+      const auto& values = state.get_list(key);
+      if (values.size() != size) {
+        throw StateError(std::string("flow_balance: '") + key + "' has the wrong length");
+      }
+      return values;
+    };
+    auto hop_at = [](const double* v) {
+      Hop h;
+      h.t = v[0];
+      h.opening = v[1];
+      h.load = v[2];
+      h.root = v[3];
+      h.leak_term = v[4];
+      h.speed = v[5];
+      h.supply = v[6];
+      h.viscosity_ratio = v[7];
+      h.usable = v[8] != 0.0;
+      return h;
+    };
+    const auto& learned = state.get_list("learned_rest_hops");
+    if (learned.size() % (kHopValues + 1) != 0 ||
+        learned.size() / (kHopValues + 1) > learned_.capacity()) {
+      throw StateError("flow_balance: learned hops do not fit this configuration");
+    }
+    const double cusum = state.get("cusum");
+    if (!std::isfinite(cusum)) throw StateError("flow_balance: CUSUM not finite");
+    observations_ = state.get_count("observations");
+    hops_seen_ = state.get_count("hops_seen");
+    previous_x_ = state.get("previous_x");
+    before_ = hop_at(list("before", kHopValues).data());
+    pending_ = hop_at(list("pending", kHopValues).data());
+    for (std::size_t i = 0; i < learned.size(); i += kHopValues + 1) {
+      const double block = learned[i + kHopValues];
+      if (!(block >= 0.0) || std::floor(block) != block) {
+        throw StateError("flow_balance: block number is not a count");
+      }
+      learned_.push_back({hop_at(&learned[i]), static_cast<std::size_t>(block)});
+    }
+    learned_model_ = state.get("learned_model") != 0.0;
+    const auto& positive = list("positive_loads", 3);
+    const auto& negative = list("negative_loads", 3);
+    positive_loads_ = {positive[0], positive[1], positive[2]};
+    negative_loads_ = {negative[0], negative[1], negative[2]};
+    const auto& coefficients = list("coefficients", kTerms);
+    for (int i = 0; i < kTerms; ++i) coefficients_[i] = coefficients[static_cast<std::size_t>(i)];
+    hop_sigma_ = state.get("hop_sigma");
+    block_sigma_ = state.get("block_sigma");
+    block_hop_ = state.get_count("block_hop");
+    block_rest_hops_ = state.get_count("block_rest_hops");
+    if (block_hop_ >= block_hops_ || block_rest_hops_ > block_hop_) {
+      throw StateError("flow_balance: block position out of range");
+    }
+    const auto& block_sums = list("block_sums", 2);
+    block_residual_sum_ = block_sums[0];
+    block_leak_term_sum_ = block_sums[1];
+    for (const auto& [key, sums] :
+         {std::pair{"weighted", &weighted_}, std::pair{"since_change", &since_change_},
+          std::pair{"change_block", &change_block_}}) {
+      const auto& v = list(key, 3);
+      *sums = SlopeSums{v[0], v[1], v[2]};
+    }
+    cusum_.restore(cusum);
+    const auto& trend = list("trend", trend_.size() * 3);
+    const std::size_t trend_next = state.get_count("trend_next");
+    const std::size_t trend_count = state.get_count("trend_count");
+    if (trend_next >= trend_.size() || trend_count > trend_.size()) {
+      throw StateError("flow_balance: trend position out of range");
+    }
+    for (std::size_t i = 0; i < trend_.size(); ++i) {
+      trend_[i] = {trend[3 * i], trend[3 * i + 1], trend[3 * i + 2]};
+    }
+    trend_next_ = trend_next;
+    trend_count_ = trend_count;
+    const auto& supply = list("supply", 2);
+    supply_estimate_ = supply[0];
+    supply_settled_since_ = supply[1];
+    temperature_seen_ = state.get("temperature_seen") != 0.0;
+    const auto& d = list("last_decision", 7);
+    last_.score = d[0];
+    last_.learning = d[1] != 0.0;
+    last_.baseline = d[2];
+    last_.index = d[3];
+    last_.leak_coefficient = d[4];
+    last_.leak_coefficient_ci = d[5];
+    last_.viscosity_ratio = d[6];
+  } catch (...) {
+    reset();
+    throw;
+  }
+}
+
+// The drift trend and the supply transient are on the old source clock; the hops before the
+// gap are not neighbours of the next ones.
+void FlowBalanceDetector::resume_after_gap() {
+  trend_next_ = trend_count_ = 0;
+  supply_settled_since_ = kMissing;
+  previous_x_ = kMissing;
+  before_ = pending_ = Hop{};
 }
 
 }  // namespace leakmon::detect

@@ -73,6 +73,9 @@ class FlowBalanceDetector final : public Detector {
   double raise_threshold() const override { return 1.0; }
   double clear_threshold() const override { return 0.5; }
   void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
+  void resume_after_gap() override;
 
  private:
   struct Hop {

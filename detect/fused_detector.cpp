@@ -1,7 +1,9 @@
 #include "detect/fused_detector.hpp"
 
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace leakmon::detect {
 
@@ -35,6 +37,37 @@ Decision FusedDetector::update(const Observation& observation) {
     }
   }
   return fused;
+}
+
+}  // namespace leakmon::detect
+
+namespace leakmon::detect {
+
+namespace {
+constexpr int kFusedStateVersion = 1;
+}  // namespace
+
+DetectorState FusedDetector::export_state() const {
+  DetectorState state(std::string(name()), kFusedStateVersion);
+  state.put_count("members", members_.size());
+  for (std::size_t i = 0; i < members_.size(); ++i) {
+    state.put_nested("m" + std::to_string(i), members_[i]->export_state());
+  }
+  return state;
+}
+
+void FusedDetector::import_state(const DetectorState& state) {
+  reset();
+  try {
+    state.expect(name(), kFusedStateVersion);
+    if (state.get_count("members") != members_.size()) throw StateError("fused: member count");
+    for (std::size_t i = 0; i < members_.size(); ++i) {
+      members_[i]->import_state(state.get_nested("m" + std::to_string(i)));
+    }
+  } catch (...) {
+    reset();
+    throw;
+  }
 }
 
 }  // namespace leakmon::detect

@@ -21,6 +21,11 @@ class FusedDetector final : public Detector {
   double raise_threshold() const override { return 1.0; }
   double clear_threshold() const override { return 0.5; }
   void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
+  void resume_after_gap() override {
+    for (auto& member : members_) member->resume_after_gap();
+  }
 
   // The latest decision of each member (same order as given), for diagnostics and evaluation.
   const std::vector<Decision>& member_decisions() const { return member_decisions_; }

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "detect/least_squares.hpp"
 
@@ -142,6 +145,76 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   decision.baseline = std::isnan(last_expected_) ? kMissing : std::exp(last_expected_);
   decision.score = cusum_.normalised();
   return decision;
+}
+
+}  // namespace leakmon::detect
+
+namespace leakmon::detect {
+
+namespace {
+constexpr int kIndexStateVersion = 1;
+}  // namespace
+
+DetectorState IndexCusumDetector::export_state() const {
+  DetectorState state(std::string(name()), kIndexStateVersion);
+  state.put_count("hops_seen", hops_seen_);
+  std::vector<double> learned;
+  learned.reserve(learned_.size() * 4);
+  for (const auto& b : learned_) {
+    learned.insert(learned.end(), {b.log_index, b.load, b.load_squared, b.log_activity});
+  }
+  state.put("learned_blocks", learned);
+  state.put("learned_model", learned_model_ ? 1.0 : 0.0);
+  state.put("coefficients", coefficients_);
+  state.put("block_sigma", block_sigma_);
+  state.put_count("block_hop", block_hop_);
+  state.put_count("block_valid", block_valid_);
+  state.put("block_sums",
+            std::vector<double>{sum_log_index_, sum_load_, sum_load_squared_, sum_activity_});
+  state.put("previous_load", previous_load_);
+  state.put("last_expected", last_expected_);
+  state.put("cusum", cusum_.value());
+  return state;
+}
+
+void IndexCusumDetector::import_state(const DetectorState& state) {
+  reset();
+  try {
+    state.expect(name(), kIndexStateVersion);
+    const auto& learned = state.get_list("learned_blocks");
+    if (learned.size() % 4 != 0 || learned.size() / 4 > learned_.capacity()) {
+      throw StateError("index_cusum: learned blocks do not fit this configuration");
+    }
+    const auto& coefficients = state.get_list("coefficients");
+    const auto& sums = state.get_list("block_sums");
+    if (coefficients.size() != kRegressors || sums.size() != 4) {
+      throw StateError("index_cusum: wrong number of coefficients or sums");
+    }
+    const double cusum = state.get("cusum");
+    if (!std::isfinite(cusum)) throw StateError("index_cusum: CUSUM not finite");
+    hops_seen_ = state.get_count("hops_seen");
+    for (std::size_t i = 0; i < learned.size(); i += 4) {
+      learned_.push_back({learned[i], learned[i + 1], learned[i + 2], learned[i + 3]});
+    }
+    learned_model_ = state.get("learned_model") != 0.0;
+    std::copy(coefficients.begin(), coefficients.end(), coefficients_);
+    block_sigma_ = state.get("block_sigma");
+    block_hop_ = state.get_count("block_hop");
+    block_valid_ = state.get_count("block_valid");
+    if (block_hop_ >= block_hops_ || block_valid_ > block_hop_) {
+      throw StateError("index_cusum: block position out of range");
+    }
+    sum_log_index_ = sums[0];
+    sum_load_ = sums[1];
+    sum_load_squared_ = sums[2];
+    sum_activity_ = sums[3];
+    previous_load_ = state.get("previous_load");
+    last_expected_ = state.get("last_expected");
+    cusum_.restore(cusum);
+  } catch (...) {
+    reset();
+    throw;
+  }
 }
 
 }  // namespace leakmon::detect

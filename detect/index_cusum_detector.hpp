@@ -34,6 +34,8 @@ class IndexCusumDetector final : public Detector {
   double raise_threshold() const override { return 1.0; }
   double clear_threshold() const override { return 0.5; }
   void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
 
  private:
   // One block's means: the response and its regressors.

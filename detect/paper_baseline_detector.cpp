@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace leakmon::detect {
 
@@ -58,6 +61,62 @@ Decision PaperBaselineDetector::update(const Observation& observation) {
     decision.score = static_cast<double>(below_count_) / static_cast<double>(below_.size());
   }
   return decision;
+}
+
+}  // namespace leakmon::detect
+
+namespace leakmon::detect {
+
+namespace {
+constexpr int kPaperStateVersion = 1;
+}  // namespace
+
+DetectorState PaperBaselineDetector::export_state() const {
+  DetectorState state(std::string(name()), kPaperStateVersion);
+  state.put_count("hops_seen", hops_seen_);
+  state.put("learned", learned_);
+  state.put("baseline", baseline_);
+  const std::vector<double> below(below_.begin(), below_.end());
+  state.put("below", below);
+  state.put_count("ring_next", ring_next_);
+  state.put_count("ring_filled", ring_filled_);
+  state.put_count("below_count", below_count_);
+  return state;
+}
+
+void PaperBaselineDetector::import_state(const DetectorState& state) {
+  reset();
+  try {
+    state.expect(name(), kPaperStateVersion);
+    const auto& learned = state.get_list("learned");
+    const auto& below = state.get_list("below");
+    if (learned.size() > learned_.capacity())
+      throw StateError(
+          "paper: more learned hops than "
+          "this configuration learns");
+    if (below.size() != below_.size()) throw StateError("paper: judging window differs");
+    const std::size_t ring_next = state.get_count("ring_next");
+    const std::size_t ring_filled = state.get_count("ring_filled");
+    if (ring_next >= below_.size() || ring_filled > below_.size()) {
+      throw StateError("paper: ring position out of range");
+    }
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < below.size(); ++i) {
+      if (below[i] != 0.0 && below[i] != 1.0) throw StateError("paper: verdict not 0 or 1");
+      below_[i] = static_cast<unsigned char>(below[i]);
+      count += below_[i];
+    }
+    if (count != state.get_count("below_count")) throw StateError("paper: verdict count differs");
+    hops_seen_ = state.get_count("hops_seen");
+    learned_.assign(learned.begin(), learned.end());
+    baseline_ = state.get("baseline");
+    ring_next_ = ring_next;
+    ring_filled_ = ring_filled;
+    below_count_ = count;
+  } catch (...) {
+    reset();
+    throw;
+  }
 }
 
 }  // namespace leakmon::detect

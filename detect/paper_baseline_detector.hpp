@@ -31,6 +31,8 @@ class PaperBaselineDetector final : public Detector {
   double raise_threshold() const override { return options_.raise_fraction; }
   double clear_threshold() const override { return options_.clear_fraction; }
   void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
 
  private:
   PaperBaselineOptions options_;

@@ -21,6 +21,12 @@ enum class EventKind {
   overrun,
   config_reloaded,
   config_rejected,
+  // Persistence (state_store.hpp): what was learned came back from the state directory, was
+  // set aside (changed configuration, newer format, corrupt file: learning starts afresh), or
+  // could not be saved.
+  state_restored,
+  state_discarded,
+  state_save_failed,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -41,6 +47,12 @@ constexpr std::string_view to_string(EventKind kind) {
       return "config_reloaded";
     case EventKind::config_rejected:
       return "config_rejected";
+    case EventKind::state_restored:
+      return "state_restored";
+    case EventKind::state_discarded:
+      return "state_discarded";
+    case EventKind::state_save_failed:
+      return "state_save_failed";
   }
   return "unknown";
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 
 #include "tests/support/paths.hpp"
@@ -38,6 +39,28 @@ TEST(DaemonConfig, MinimalConfigGetsTheDocumentedDefaults) {
   EXPECT_EQ(a.detector, "default");
   EXPECT_TRUE(std::isnan(a.alarm.raise_threshold)) << "left to the detector";
   EXPECT_EQ(config.metrics.port, 9187);
+}
+
+TEST(DaemonConfig, StateDirectoryDefaultsToSystemdsAndIsChecked) {
+  const std::string actuator = "actuators: [{name: a, channels: {p1: p1}}]\n";
+  ::setenv("STATE_DIRECTORY", "/run/first:/run/second", 1);
+  const auto from_env =
+      parse_config(config::ConfigNode::load_string(std::string(kDriver) + actuator, "rig.yaml"));
+  EXPECT_EQ(from_env.state.directory, "/run/first");
+  EXPECT_EQ(from_env.state.save_seconds, 60.0);
+  ::unsetenv("STATE_DIRECTORY");
+  const auto fallback =
+      parse_config(config::ConfigNode::load_string(std::string(kDriver) + actuator, "rig.yaml"));
+  EXPECT_EQ(fallback.state.directory, "/var/lib/leakmon");
+  const auto relative = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) + actuator + "state: {directory: kept, save_seconds: 5}\n",
+      "/etc/leakmon/rig.yaml"));
+  EXPECT_EQ(relative.state.directory, "/etc/leakmon/kept");
+  EXPECT_EQ(relative.state.save_seconds, 5.0);
+  const std::string error =
+      error_of(std::string(kDriver) + actuator + "state: {save_seconds: 0.1}\n");
+  EXPECT_NE(error.find("rig.yaml:3:"), std::string::npos) << error;
+  EXPECT_NE(error.find("save_seconds"), std::string::npos) << error;
 }
 
 TEST(DaemonConfig, UnknownKeyNamesLineColumnAndPath) {

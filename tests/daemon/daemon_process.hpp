@@ -31,6 +31,9 @@ class DaemonProcess {
       const int fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
+      // Each process keeps its learned state next to its log unless told otherwise, so that
+      // runs never resume from one another through the default /var/lib/leakmon.
+      ::setenv("STATE_DIRECTORY", (log_path_ + ".state").c_str(), 1);
       for (const auto& [key, value] : env) ::setenv(key.c_str(), value.c_str(), 1);
       std::vector<char*> argv;
       std::string binary = leakmon_binary();

@@ -81,6 +81,8 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotAlarmsAndTheRecordingEqualsTheServedCaptu
                            "recording:\n"
                            "  directory: recording\n"
                            "  flush_seconds: 0.1\n"
+                           "state:\n"
+                           "  directory: state\n"
                            "metrics:\n"
                            "  port: 0\n";
   ChildProcess daemon({leakmon_binary(), "run", "--config", config}, dir + "/daemon.log");
