@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "detect/index_cusum_detector.hpp"
@@ -62,9 +64,9 @@ struct Acquired {
 };
 
 struct Outcome {
-  int false_alarms = 0;        // raises before the onset (re-armed when the score clears)
-  double monitored_s = 0.0;    // judged time before the onset
-  double first_raise = -1.0;   // first raise at or after the onset
+  int false_alarms = 0;       // raises before the onset (re-armed when the score clears)
+  double monitored_s = 0.0;   // judged time before the onset
+  double first_raise = -1.0;  // first raise at or after the onset
   double max_score_before = 0.0;
 };
 
@@ -153,6 +155,26 @@ std::vector<Case> drift_cases(std::uint64_t seed) {
       cases.push_back({period < 600 ? "cooler 4K/300s" : "cooler 2K/1200s", s});
     }
     {
+      // End of shift: learned warm, then the oil cools from 50 to 30 degC (tau 300 s).
+      sim::Scenario s = base(seed + 4, ft, 1800.0);
+      auto p = warm_up_profile(50.0, 300.0);
+      p.T_work = 30.0;
+      p.start_s = 300.0;
+      s.conditions.temperature = p;
+      cases.push_back({"cool-down 50->30 tau 300 from 300 s", s});
+    }
+    {
+      sim::Scenario s = base(seed + 5, ft, 1500.0 + 120.0);
+      s.conditions.temperature = warm_up_profile(20.0, 300.0);
+      s.effects.internal_leakage = sim::InternalLeakage{2e-12, 1500.0, 0.0};
+      cases.push_back({"leak 2e-12 at 1500 s after warm-up tau 300", s, 1500.0});
+    }
+    {
+      sim::Scenario s = base(seed + 6, ft, 600.0 + 120.0);
+      s.effects.internal_leakage = sim::InternalLeakage{2e-12, 600.0, 0.0};
+      cases.push_back({"leak 2e-12 at 600 s, 40 degC", s, 600.0});
+    }
+    {
       sim::Scenario s = base(seed + 3, ft, 1200.0);
       s.conditions.supply = {{300.0, 14e6, 2.0}, {700.0, 20e6, 0.0}};
       cases.push_back({"supply 17.2->14->20 MPa", s});
@@ -166,15 +188,23 @@ std::vector<Case> drift_cases(std::uint64_t seed) {
 TEST(IndexCusumOnTheSimulatedRig, Survey) {
   const char* env = std::getenv("LEAKMON_INDEX_SEEDS");
   const int seeds = env != nullptr ? std::atoi(env) : 0;
-  for (int k = 0; k < seeds; ++k) {
+  const char* only = std::getenv("LEAKMON_INDEX_CASE");
+  const int first =
+      std::getenv("LEAKMON_INDEX_FIRST") ? std::atoi(std::getenv("LEAKMON_INDEX_FIRST")) : 0;
+  for (int k = first; k < seeds; ++k) {
     for (const auto& c : drift_cases(100 + 10 * static_cast<std::uint64_t>(k))) {
+      if (only != nullptr && std::string(c.name).find(only) == std::string::npos) continue;
       const auto stream = observations_of(c.scenario);
       for (const Acquired a : {Acquired{true, false, false}, Acquired{false, false, false},
-                               Acquired{true, true, true}, Acquired{false, true, false}}) {
+                               Acquired{true, true, true}, Acquired{false, true, true}}) {
+        if (std::getenv("LEAKMON_INDEX_TEMP") && !a.temp) continue;
         const Outcome o = run(stream, a, c.onset);
-        std::printf("SURVEY seed %d ctl %d %-42s p2 %d temp %d ps %d: alarms %d in %.3f h, max %.2f\n",
-                    k, static_cast<int>(c.scenario.controller), c.name, a.p2, a.temp, a.ps,
-                    o.false_alarms, o.monitored_s / 3600.0, o.max_score_before);
+        std::printf(
+            "SURVEY seed %d ctl %d %-42s p2 %d temp %d ps %d: alarms %d in %.3f h, max %.2f, raise "
+            "%.1f\n",
+            k, static_cast<int>(c.scenario.controller), c.name, a.p2, a.temp, a.ps, o.false_alarms,
+            o.monitored_s / 3600.0, o.max_score_before,
+            o.first_raise < 0 ? -1.0 : o.first_raise - c.onset);
       }
     }
   }
