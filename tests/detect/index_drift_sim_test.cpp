@@ -210,5 +210,49 @@ TEST(IndexCusumOnTheSimulatedRig, Survey) {
   }
 }
 
+// Fixed seeds (the survey's first), both controllers. The supply is invisible to p1 alone without
+// a ps channel (p1 = (ps + pt + load) / 2 at rest), so that combination is not asserted.
+TEST(IndexCusumOnTheSimulatedRig, DriftRaisesNothing) {
+  for (const auto& c : drift_cases(100)) {
+    const std::string name = c.name;
+    if (c.onset < 1e300 || name.find("warm-up 20") != std::string::npos ||
+        name.find("2K") != std::string::npos) {
+      continue;  // leaks below; the milder drifts are in the survey
+    }
+    const bool supply = name.find("supply") != std::string::npos;
+    const auto stream = observations_of(c.scenario);
+    for (const Acquired a : {Acquired{true, false, false}, Acquired{false, false, false},
+                             Acquired{true, true, true}, Acquired{false, true, true}}) {
+      if (supply && !a.p2 && !a.ps) continue;
+      const Outcome o = run(stream, a, c.onset);
+      std::printf("controller %d %s, p2 %d temp %d ps %d: max score %.2f\n",
+                  static_cast<int>(c.scenario.controller), c.name, a.p2, a.temp, a.ps,
+                  o.max_score_before);
+      EXPECT_EQ(o.false_alarms, 0) << c.name << " p2 " << a.p2 << " temp " << a.temp;
+      EXPECT_LT(o.max_score_before, 1.0) << c.name << " p2 " << a.p2 << " temp " << a.temp;
+    }
+  }
+}
+
+// 2e-12 m^3/(s Pa) at 1500 s, after a warm-up from 20 to 50 degC (tau 300 s): the index rose by
+// about 15 % above what was learned, so a stationary detector judged the leak against a baseline
+// that was too low (seed 105: 85 s and 24 s, and never within 120 s for another seed).
+TEST(IndexCusumOnTheSimulatedRig, ALeakAfterTheWarmUpIsFound) {
+  for (const auto& c : drift_cases(100)) {
+    if (std::string(c.name).find("after warm-up") == std::string::npos) continue;
+    const auto stream = observations_of(c.scenario);
+    for (const Acquired a :
+         {Acquired{true, false, false}, Acquired{true, true, true}, Acquired{false, true, true}}) {
+      const Outcome o = run(stream, a, c.onset);
+      std::printf("controller %d, p2 %d temp %d: max before %.2f, found %.1f s after the onset\n",
+                  static_cast<int>(c.scenario.controller), a.p2, a.temp, o.max_score_before,
+                  o.first_raise - c.onset);
+      EXPECT_EQ(o.false_alarms, 0) << "p2 " << a.p2 << " temp " << a.temp;
+      EXPECT_GT(o.first_raise, c.onset) << "p2 " << a.p2 << " temp " << a.temp;
+      EXPECT_LT(o.first_raise, c.onset + 90.0) << "p2 " << a.p2 << " temp " << a.temp;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace leakmon::detect
