@@ -272,7 +272,14 @@ double IndexCusumDetector::drift_reference(double t) const {
   }
   const double det = s * stt - st * st;
   if (!(det > 0.0)) return level;
-  const double extrapolated = (r * stt - rt * st) / det;
+  // Slope of the trend and its variance (blocks with the learned long-run spread). A slope that
+  // the window barely identifies would carry its noise over the guard (with the default window
+  // about as much as the designed drop), so it is shrunk by b^2 / (b^2 + var b): a clear trend
+  // is followed, noise is not.
+  const double slope = (s * rt - st * r) / det;
+  const double slope_variance = block_sigma_ * block_sigma_ * s / det;
+  const double shrink = slope * slope / (slope * slope + slope_variance);
+  const double extrapolated = level - shrink * slope * (st / s);
   const double bound = -std::log1p(-options_.design_drop);
   return level + std::clamp(extrapolated - level, -bound, bound);
 }

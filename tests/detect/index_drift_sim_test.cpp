@@ -68,6 +68,7 @@ struct Outcome {
   double monitored_s = 0.0;   // judged time before the onset
   double first_raise = -1.0;  // first raise at or after the onset
   double max_score_before = 0.0;
+  double t_max_score = 0.0;  // when it was reached
 };
 
 Outcome run(const std::vector<Observation>& stream, const Acquired& acquired, double onset,
@@ -84,7 +85,10 @@ Outcome run(const std::vector<Observation>& stream, const Acquired& acquired, do
     if (d.learning) continue;
     if (o.t < onset) outcome.monitored_s += kHop;
     if (std::isnan(d.score)) continue;
-    if (o.t < onset) outcome.max_score_before = std::max(outcome.max_score_before, d.score);
+    if (o.t < onset && d.score > outcome.max_score_before) {
+      outcome.max_score_before = d.score;
+      outcome.t_max_score = o.t;
+    }
     if (!raised && d.score >= detector.raise_threshold()) {
       raised = true;
       if (o.t < onset) {
@@ -244,9 +248,11 @@ TEST(IndexCusumOnTheSimulatedRig, ALeakAfterTheWarmUpIsFound) {
     for (const Acquired a :
          {Acquired{true, false, false}, Acquired{true, true, true}, Acquired{false, true, true}}) {
       const Outcome o = run(stream, a, c.onset);
-      std::printf("controller %d, p2 %d temp %d: max before %.2f, found %.1f s after the onset\n",
-                  static_cast<int>(c.scenario.controller), a.p2, a.temp, o.max_score_before,
-                  o.first_raise - c.onset);
+      std::printf(
+          "controller %d, p2 %d temp %d: max before %.2f (t %.0f s), found %.1f s after the "
+          "onset\n",
+          static_cast<int>(c.scenario.controller), a.p2, a.temp, o.max_score_before, o.t_max_score,
+          o.first_raise - c.onset);
       EXPECT_EQ(o.false_alarms, 0) << "p2 " << a.p2 << " temp " << a.temp;
       EXPECT_GT(o.first_raise, c.onset) << "p2 " << a.p2 << " temp " << a.temp;
       EXPECT_LT(o.first_raise, c.onset + 90.0) << "p2 " << a.p2 << " temp " << a.temp;
