@@ -62,9 +62,9 @@ void IndexCusumDetector::reset() {
   block_hop_ = block_valid_ = block_temps_ = 0;
   sum_log_index_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_ratio_ = sum_log_supply_ = 0.0;
-  previous_load_ = last_expected_ = kMissing;
+  previous_load_ = previous_rough_load_ = last_expected_ = kMissing;
   temperature_seen_ = false;
-  supply_estimate_ = supply_step_since_ = kMissing;
+  supply_estimate_ = supply_anchor_ = supply_step_since_ = kMissing;
   supply_off_hops_ = 0;
   cusum_.reset();
   trend_next_ = trend_count_ = 0;
@@ -106,18 +106,18 @@ double IndexCusumDetector::supply_for(const Observation& o, double load) {
     reading = o.ps;
     direct = true;
   } else if (options_.use_p1 && options_.use_p2 && !std::isnan(o.p1) && !std::isnan(o.p2) &&
-             std::abs(load - previous_load_) < kRestActivity) {
+             std::abs(load - previous_rough_load_) < kRestActivity) {
     reading = o.p1 + o.p2 - options_.tank_pressure;
   }
+  previous_rough_load_ = load;
   if (std::isnan(reading)) return std::isnan(supply_estimate_) ? configured : supply_estimate_;
   if (std::isnan(supply_estimate_)) {
-    supply_estimate_ = reading;
-  } else if (std::abs(reading - supply_estimate_) > kSupplyStep * configured) {
-    if (direct || ++supply_off_hops_ >= kSupplyStepHops) {
+    supply_estimate_ = supply_anchor_ = reading;
+  } else if (!direct && std::abs(reading - supply_estimate_) > kSupplyStep * configured) {
+    // A rest reading far from the estimate: a step if it persists (not one odd hop).
+    if (++supply_off_hops_ >= kSupplyStepHops) {
       supply_estimate_ = reading;
-      supply_step_since_ = o.t;
       supply_off_hops_ = 0;
-      trend_count_ = trend_next_ = 0;
     }
   } else {
     supply_off_hops_ = 0;
@@ -126,6 +126,12 @@ double IndexCusumDetector::supply_for(const Observation& o, double load) {
                               : std::exp(-options_.block_seconds /
                                          static_cast<double>(block_hops_) / kSupplyMemorySeconds);
     supply_estimate_ = memory * supply_estimate_ + (1.0 - memory) * reading;
+  }
+  // Judged against the supply the reference was anchored at, so that a ramp is a step too.
+  if (std::abs(supply_estimate_ - supply_anchor_) > kSupplyStep * configured) {
+    supply_anchor_ = supply_estimate_;
+    supply_step_since_ = o.t;
+    trend_count_ = trend_next_ = 0;
   }
   return supply_estimate_;
 }
@@ -250,7 +256,7 @@ double IndexCusumDetector::drift_reference(double t) const {
     newest = std::max(newest, supply_step_since_ + options_.supply_settle_seconds);
   }
   const double oldest = t - options_.drift_guard_seconds - options_.drift_window_seconds;
-  double s = 0.0, st = 0.0, stt = 0.0, r = 0.0, rt = 0.0;
+  double s = 0.0, st = 0.0, stt = 0.0, r = 0.0, rt = 0.0, earliest = t;
   std::size_t n = 0;
   for (std::size_t i = 0; i < trend_count_; ++i) {
     const TrendBlock& b = trend_[i];
@@ -261,13 +267,17 @@ double IndexCusumDetector::drift_reference(double t) const {
     stt += tau * tau;
     r += b.residual;
     rt += b.residual * tau;
+    earliest = std::min(earliest, b.t);
     ++n;
   }
   if (n < kTrendLevelBlocks) return 0.0;
   const double level = r / s;  // at the window's centre
   // With a temperature the model follows the oil itself and only a slow remainder is left: the
   // level suffices, and a slope extrapolated over the guard would only add its noise.
-  if (n < kTrendSlopeBlocks || !(options_.drift_window_seconds > 0.0) || temperature_seen_) {
+  // A slope also needs the window's full length (after a supply step it refills): over a
+  // shorter span its noise, extrapolated over the guard, would exceed the drift it follows.
+  if (n < kTrendSlopeBlocks || !(options_.drift_window_seconds > 0.0) || temperature_seen_ ||
+      newest - earliest < 0.9 * options_.drift_window_seconds) {
     return level;
   }
   const double det = s * stt - st * st;

@@ -98,10 +98,12 @@ class IndexCusumDetector final : public Detector {
   double sum_log_index_ = 0.0, sum_load_ = 0.0, sum_load_squared_ = 0.0, sum_activity_ = 0.0;
   double sum_log_ratio_ = 0.0, sum_log_supply_ = 0.0;
   double previous_load_ = kMissing;
+  double previous_rough_load_ = kMissing;  // normalised by the configured supply
   double last_expected_ = kMissing;
   bool temperature_seen_ = false;
   // Supply tracking.
   double supply_estimate_ = kMissing;
+  double supply_anchor_ = kMissing;      // the supply at the last (re-)anchoring
   double supply_step_since_ = kMissing;  // t of the last supply step
   std::size_t supply_off_hops_ = 0;      // consecutive rest readings away from the estimate
   Cusum cusum_;

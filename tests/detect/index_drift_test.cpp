@@ -129,17 +129,15 @@ TEST(IndexCusumDrift, SupplySetPointChangesAreNotALeak) {
     rig.report_supply = with_ps;
     rig.onset = 1200.0;
     rig.index_drop = 0.2;
-    const RunResult r = run(detector, rig, 1320.0);
+    const RunResult r = run(detector, rig, 1400.0);
     std::printf("p2 %d ps %d: first raise %.1f, max healthy score %.2f\n", both, with_ps,
                 r.first_raise, r.max_healthy_score);
     SCOPED_TRACE(testing::Message() << "p2 " << both << " ps channel " << with_ps);
     EXPECT_LT(r.max_healthy_score, 1.0);
-    // A leak at 20 MPa is still found with a ps channel. Without one it was found only 300 s
-    // after the onset (not understood yet; see the branch's report), so that is not asserted.
-    if (with_ps) {
-      EXPECT_GT(r.first_raise, rig.onset);
-      EXPECT_LT(r.first_raise, rig.onset + 90.0);
-    }
+    // And a leak at 20 MPa is still found; over eight noise seeds 35-120 s after the onset
+    // without a ps channel, 24-63 s with one.
+    EXPECT_GT(r.first_raise, rig.onset);
+    EXPECT_LT(r.first_raise, rig.onset + (with_ps ? 90.0 : 150.0));
   }
 }
 
