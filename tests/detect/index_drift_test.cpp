@@ -9,6 +9,7 @@
 #include "detect/factory.hpp"
 #include "detect/index_cusum_detector.hpp"
 #include "tests/detect/synthetic_rig.hpp"
+#include "tests/support/alloc_counter.hpp"
 
 namespace leakmon::detect {
 namespace {
@@ -149,6 +150,30 @@ TEST(IndexCusumDrift, ADropBelowTheMinimumOfInterestIsNotAnAlarm) {
   rig.onset = 300.0;
   rig.index_drop = 0.01;
   EXPECT_LT(run(detector, rig, 3900.0).first_raise, 0.0);
+}
+
+// The drift paths (temperature regressor, supply steps, the reference ring) allocate nothing
+// either: learning, re-anchoring after a step, judging and an alarm in one scope.
+TEST(IndexCusumDrift, UpdateAllocatesNothingWithTemperatureAndSupply) {
+  for (const bool report : {false, true}) {
+    auto detector = make(true);
+    auto rig = drifting_rig(cooler, report);
+    rig.supply = [](double t) { return t < 200.0 ? 17.2e6 : 14e6; };
+    rig.report_supply = report;
+    rig.onset = 400.0;
+    rig.index_drop = 0.3;
+    std::uint64_t allocations = 0;
+    bool raised = false;
+    while (rig.t < 600.0) {
+      const Observation o = rig.next();
+      test::AllocationScope scope;
+      const Decision d = detector.update(o);
+      allocations += scope.count();
+      raised = raised || d.score >= 1.0;
+    }
+    EXPECT_EQ(allocations, 0u) << report;
+    EXPECT_TRUE(raised) << report;
+  }
 }
 
 TEST(IndexCusumDrift, Options) {
