@@ -35,8 +35,12 @@ void read_learning(const config::ConfigNode* options, LearningSchedule& learning
 
 using KeyList = std::span<const std::string_view>;
 constexpr std::string_view kLearningKeysData[] = {"settle_seconds", "learn_seconds"};
-constexpr std::string_view kIndexKeysData[] = {"design_drop", "false_alarms_per_hour",
-                                               "block_seconds", "supply_pressure"};
+constexpr std::string_view kIndexKeysData[] = {
+    "design_drop",          "false_alarms_per_hour",   "block_seconds",
+    "supply_pressure",      "tank_pressure",           "min_drop",
+    "temperature_prior",    "temperature_prior_sigma", "drift_guard_seconds",
+    "drift_window_seconds", "supply_settle_seconds",   "oil_grade",
+    "oil_viscosity_40",     "oil_viscosity_100"};
 constexpr std::string_view kFlowKeysData[] = {"supply_pressure",
                                               "tank_pressure",
                                               "command_full_scale",
@@ -74,20 +78,6 @@ void expect_keys(const config::ConfigNode* options, std::initializer_list<KeyLis
   options->expect_keys(allowed);
 }
 
-IndexCusumOptions index_options(const config::ConfigNode* options, const AvailableSignals& s,
-                                double false_alarm_share) {
-  IndexCusumOptions o;
-  read_learning(options, o.learning);
-  read(options, "design_drop", o.design_drop, 0.005, 0.9);
-  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
-  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
-  read(options, "supply_pressure", o.supply_pressure, 1e5, 1e9);
-  o.false_alarms_per_hour *= false_alarm_share;
-  o.use_p1 = s.p1;
-  o.use_p2 = s.p2;
-  return o;
-}
-
 // The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
 // two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; VG 46 when
 // neither is given.
@@ -111,6 +101,34 @@ sim::Oil oil_of(const config::ConfigNode& options) {
     return sim::Oil(a, b);
   }
   return sim::Oil::standard();
+}
+
+IndexCusumOptions index_options(const config::ConfigNode* options, const AvailableSignals& s,
+                                double false_alarm_share) {
+  IndexCusumOptions o;
+  read_learning(options, o.learning);
+  read(options, "design_drop", o.design_drop, 0.005, 0.9);
+  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
+  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
+  read(options, "supply_pressure", o.supply_pressure, 1e5, 1e9);
+  read(options, "tank_pressure", o.tank_pressure, 0.0, 1e8);
+  read(options, "min_drop", o.min_drop, 0.0, 0.5);
+  read(options, "temperature_prior", o.temperature_prior, -2.0, 2.0);
+  read(options, "temperature_prior_sigma", o.temperature_prior_sigma, 1e-4, 10.0);
+  read(options, "drift_guard_seconds", o.drift_guard_seconds, 0.0, 3600.0);
+  read(options, "drift_window_seconds", o.drift_window_seconds, 0.0, 3600.0);
+  read(options, "supply_settle_seconds", o.supply_settle_seconds, 0.0, 3600.0);
+  if (options != nullptr) {
+    o.oil = oil_of(*options);
+    if (o.min_drop >= o.design_drop) {
+      const auto at = options->find("min_drop");
+      (at ? *at : options->at("design_drop")).fail("min_drop must be below design_drop");
+    }
+  }
+  o.false_alarms_per_hour *= false_alarm_share;
+  o.use_p1 = s.p1;
+  o.use_p2 = s.p2;
+  return o;
 }
 
 FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {

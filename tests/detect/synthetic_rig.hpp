@@ -39,6 +39,10 @@ struct SyntheticRig {
   bool report_temp = false;
   double (*supply)(double t) = nullptr;
   bool report_supply = false;
+  // The index follows the oil as ln(index) += index_friction_exponent * -ln(0.5 + 0.5 / r) (less
+  // viscous damping of the hydraulic mode in warm oil) and the supply as sqrt(ps) (the spool
+  // noise's flow); both are zero at 40 degC and the configured supply.
+  double index_friction_exponent = 0.0;
   std::mt19937_64 rng{1};
 
   double t = 0.0;
@@ -84,8 +88,10 @@ struct SyntheticRig {
     // Index: load-dependent level, AR(1) with about one window of memory, drop after onset.
     window_level = 0.95 * window_level + std::sqrt(1 - 0.95 * 0.95) * index_noise * normal(rng);
     const double load = dp / valve.supply_pressure;
+    const double drift = -index_friction_exponent * std::log(sim::friction_factor(r)) +
+                         0.5 * std::log(now.supply_pressure / valve.supply_pressure);
     const double log_index = std::log(30e3) - 0.8 * load * load + 0.1 * load + window_level +
-                             (t >= onset ? std::log1p(-index_drop) : 0.0);
+                             drift + (t >= onset ? std::log1p(-index_drop) : 0.0);
     o.index_p1 = std::exp(log_index + 0.02 * normal(rng));
     o.index_p2 = std::exp(log_index + 0.02 * normal(rng));
     o.x_activity = 0.03;
