@@ -15,29 +15,6 @@ namespace {
 constexpr AvailableSignals kAll{true, true, true, true};
 constexpr AvailableSignals kPressuresOnly{true, true, false, false};
 
-struct RunResult {
-  double first_raise = -1.0;  // time of the first hop with score >= raise threshold
-  double max_healthy_score = 0.0;
-  Decision last;
-};
-
-// Feeds `seconds` of the rig to the detector; healthy hops are those before the rig's onset.
-RunResult run(Detector& detector, test::SyntheticRig& rig, double seconds) {
-  RunResult result;
-  while (rig.t < seconds) {
-    const Observation o = rig.next();
-    result.last = detector.update(o);
-    if (std::isnan(result.last.score)) continue;
-    if (o.t < rig.onset) {
-      result.max_healthy_score = std::max(result.max_healthy_score, result.last.score);
-    }
-    if (result.first_raise < 0 && result.last.score >= detector.raise_threshold()) {
-      result.first_raise = o.t;
-    }
-  }
-  return result;
-}
-
 TEST(DetectorFactory, DefaultDependsOnAcquiredChannels) {
   EXPECT_EQ(default_detector_kind(kAll), "flow_balance");
   EXPECT_EQ(default_detector_kind(kPressuresOnly), "index_cusum");
@@ -83,7 +60,7 @@ TEST(PaperBaselineDetector, LearnsBaselineAndFlagsALargeDrop) {
   test::SyntheticRig rig;
   rig.onset = 300.0;
   rig.index_drop = 0.5;  // the paper's rule only reacts to a drop well beyond the scatter
-  const RunResult r = run(*detector, rig, 400.0);
+  const test::DetectorRun r = test::run_detector(*detector, rig, 400.0);
   EXPECT_FALSE(r.last.learning);
   EXPECT_GT(r.last.baseline, 15e3);
   EXPECT_LT(r.last.baseline, 40e3);
@@ -97,7 +74,7 @@ TEST(IndexCusumDetector, QuietWhenHealthyAndRaisesAfterADrop) {
   test::SyntheticRig rig;
   rig.onset = 1800.0;
   rig.index_drop = 0.20;
-  const RunResult r = run(*detector, rig, 2000.0);
+  const test::DetectorRun r = test::run_detector(*detector, rig, 2000.0);
   EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
   EXPECT_GT(r.first_raise, rig.onset);
   EXPECT_LT(r.first_raise, rig.onset + 90.0);
@@ -107,7 +84,7 @@ TEST(IndexCusumDetector, QuietWhenHealthyAndRaisesAfterADrop) {
 TEST(IndexCusumDetector, NeedsAllConfiguredChambersAndHoldsOnGaps) {
   auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
   test::SyntheticRig rig;
-  run(*detector, rig, 100.0);
+  test::run_detector(*detector, rig, 100.0);
   Observation gap = rig.next();
   gap.index_p2 = kMissing;
   const Decision d = detector->update(gap);
@@ -120,7 +97,7 @@ TEST(FlowBalanceDetector, EstimatesTheLeakWithinItsInterval) {
   test::SyntheticRig rig;
   rig.onset = 120.0;
   rig.leak = 1e-12;
-  const RunResult r = run(*detector, rig, 300.0);
+  const test::DetectorRun r = test::run_detector(*detector, rig, 300.0);
   EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
   EXPECT_GT(r.first_raise, rig.onset);
   EXPECT_LT(r.first_raise, rig.onset + 30.0);
@@ -134,7 +111,7 @@ TEST(FlowBalanceDetector, QuietOnAHealthyRigWithStrongNullLeak) {
   test::SyntheticRig rig;
   rig.null_leak = 1.5e-12;  // the valve's own leakage is learned, not alarmed on
   rig.kv *= 0.9;
-  const RunResult r = run(*detector, rig, 1200.0);
+  const test::DetectorRun r = test::run_detector(*detector, rig, 1200.0);
   EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
   EXPECT_NEAR(r.last.leak_coefficient, 0.0, r.last.leak_coefficient_ci + 0.1e-12);
 }
@@ -153,7 +130,7 @@ TEST(FlowBalanceDetector, LearnsValveBiasAndOverlapAndStillFindsASmallLeak) {
     rig.crossing_hops = 5;
     rig.onset = 900.0;
     rig.leak = 5e-13;
-    const RunResult r = run(*detector, rig, 1000.0);
+    const test::DetectorRun r = test::run_detector(*detector, rig, 1000.0);
     EXPECT_LT(r.max_healthy_score, detector->raise_threshold()) << bias;
     EXPECT_GT(r.first_raise, rig.onset) << bias;
     EXPECT_LT(r.first_raise, rig.onset + 30.0) << bias;
@@ -167,7 +144,7 @@ TEST(FusedDetector, RaisesOnLeakAndReportsSize) {
   rig.onset = 150.0;
   rig.leak = 2e-12;
   rig.index_drop = 0.12;
-  const RunResult r = run(*detector, rig, 250.0);
+  const test::DetectorRun r = test::run_detector(*detector, rig, 250.0);
   EXPECT_LT(r.max_healthy_score, 1.0);
   EXPECT_GT(r.first_raise, rig.onset);
   EXPECT_LT(r.first_raise, rig.onset + 20.0);
@@ -196,7 +173,7 @@ TEST(Detectors, ResetStartsLearningAgain) {
   for (const auto& kind : detector_kinds()) {
     auto detector = make_detector(kind, kAll, 0.04, nullptr);
     test::SyntheticRig rig;
-    run(*detector, rig, 150.0);
+    test::run_detector(*detector, rig, 150.0);
     EXPECT_FALSE(detector->update(rig.next()).learning) << kind;
     detector->reset();
     EXPECT_TRUE(detector->update(rig.next()).learning) << kind;

@@ -14,28 +14,6 @@ namespace {
 
 constexpr double kHop = 0.04;
 
-struct RunResult {
-  double first_raise = -1.0;
-  double max_healthy_score = 0.0;
-  Decision last;
-};
-
-RunResult run(Detector& detector, test::SyntheticRig& rig, double seconds) {
-  RunResult result;
-  while (rig.t < seconds) {
-    const Observation o = rig.next();
-    result.last = detector.update(o);
-    if (std::isnan(result.last.score)) continue;
-    if (o.t < rig.onset) {
-      result.max_healthy_score = std::max(result.max_healthy_score, result.last.score);
-    }
-    if (result.first_raise < 0 && result.last.score >= detector.raise_threshold()) {
-      result.first_raise = o.t;
-    }
-  }
-  return result;
-}
-
 // A cold morning: 15 degC to 55 degC with a 5 min time constant (MODEL.md's fastest warm-up,
 // from its coldest start to its hottest working temperature): the null leakage grows about
 // sixfold, which at rest looks exactly like a cross-piston leak of 8e-13.
@@ -59,7 +37,7 @@ TEST(FlowBalanceDrift, WarmUpIsNotALeakWithOrWithoutTemperature) {
     test::SyntheticRig rig;
     rig.temperature = cold_start;
     rig.report_temp = with_temp;
-    const RunResult r = run(detector, rig, 1800.0);
+    const test::DetectorRun r = test::run_detector(detector, rig, 1800.0);
     EXPECT_LT(r.max_healthy_score, detector.raise_threshold()) << "temp " << with_temp;
     // With the temperature the size is stated at 40 degC: the healthy rig has none.
     if (with_temp) {
@@ -74,7 +52,7 @@ TEST(FlowBalanceDrift, CoolerCyclesAreNotALeak) {
     test::SyntheticRig rig;
     rig.temperature = cooler;
     rig.report_temp = with_temp;
-    const RunResult r = run(detector, rig, 1800.0);
+    const test::DetectorRun r = test::run_detector(detector, rig, 1800.0);
     EXPECT_LT(r.max_healthy_score, detector.raise_threshold()) << "temp " << with_temp;
   }
 }
@@ -88,7 +66,7 @@ TEST(FlowBalanceDrift, AStationaryDetectorWouldAlarmOnTheWarmUp) {
   FlowBalanceDetector detector(options, kHop);
   test::SyntheticRig rig;
   rig.temperature = cold_start;
-  const RunResult r = run(detector, rig, 1800.0);
+  const test::DetectorRun r = test::run_detector(detector, rig, 1800.0);
   EXPECT_GT(r.max_healthy_score, detector.raise_threshold());
 }
 
@@ -101,7 +79,7 @@ TEST(FlowBalanceDrift, ALeakDuringOrAfterTheWarmUpIsFound) {
       rig.report_temp = with_temp;
       rig.onset = onset;
       rig.leak = 1e-12;  // at 40 degC
-      const RunResult r = run(detector, rig, onset + 90.0);
+      const test::DetectorRun r = test::run_detector(detector, rig, onset + 90.0);
       SCOPED_TRACE(testing::Message() << "temp " << with_temp << " onset " << onset);
       EXPECT_LT(r.max_healthy_score, detector.raise_threshold());
       EXPECT_GT(r.first_raise, onset);
@@ -120,7 +98,7 @@ TEST(FlowBalanceDrift, ALeakBelowTheMinimumOfInterestIsNotAnAlarm) {
     rig.report_temp = with_temp;
     rig.onset = 300.0;
     rig.leak = 2e-13;  // significant (the detector sees 1e-13), but below min_leak = 5e-13
-    const RunResult r = run(detector, rig, 900.0);
+    const test::DetectorRun r = test::run_detector(detector, rig, 900.0);
     EXPECT_LT(r.first_raise, 0.0) << "temp " << with_temp;
     // With the temperature the size is absolute (at 40 degC) and still reported; without it,
     // the reference follows slow changes, so a leak below the floor is absorbed as drift.
@@ -138,7 +116,7 @@ TEST(FlowBalanceDrift, SupplySetPointChangesAreNotALeak) {
     rig.report_supply = with_ps;
     rig.onset = 1200.0;
     rig.leak = 1e-12;
-    const RunResult r = run(detector, rig, 1290.0);
+    const test::DetectorRun r = test::run_detector(detector, rig, 1290.0);
     SCOPED_TRACE(testing::Message() << "ps channel " << with_ps);
     EXPECT_LT(r.max_healthy_score, detector.raise_threshold());
     EXPECT_GT(r.first_raise, rig.onset);  // and a leak at 20 MPa is still found

@@ -16,23 +16,6 @@ namespace {
 
 constexpr double kHop = 0.04;
 
-struct RunResult {
-  double first_raise = -1.0;
-  double max_healthy_score = 0.0;
-};
-
-RunResult run(Detector& detector, test::SyntheticRig& rig, double seconds) {
-  RunResult result;
-  while (rig.t < seconds) {
-    const Observation o = rig.next();
-    const Decision d = detector.update(o);
-    if (std::isnan(d.score)) continue;
-    if (o.t < rig.onset) result.max_healthy_score = std::max(result.max_healthy_score, d.score);
-    if (result.first_raise < 0 && d.score >= detector.raise_threshold()) result.first_raise = o.t;
-  }
-  return result;
-}
-
 // End of shift: learned at 50 degC, then the oil cools to 30 degC (tau 300 s). With the
 // synthetic rig's exponent 0.3 (the simulated rig measured 0.22) the healthy index falls by
 // 14 %, nearly twice the designed drop.
@@ -69,7 +52,7 @@ TEST(IndexCusumDrift, CoolDownIsNotALeak) {
     for (const bool with_temp : {false, true}) {
       auto detector = make(both);
       auto rig = drifting_rig(cool_down, with_temp);
-      const RunResult r = run(detector, rig, 2100.0);
+      const test::DetectorRun r = test::run_detector(detector, rig, 2100.0);
       EXPECT_LT(r.max_healthy_score, 1.0) << "p2 " << both << " temp " << with_temp;
     }
   }
@@ -84,7 +67,7 @@ TEST(IndexCusumDrift, AStationaryDetectorWouldAlarmOnTheCoolDown) {
   options.temperature_prior_sigma = 1e-4;
   auto detector = make(true, options);
   auto rig = drifting_rig(cool_down, true);
-  EXPECT_GT(run(detector, rig, 2100.0).max_healthy_score, 1.0);
+  EXPECT_GT(test::run_detector(detector, rig, 2100.0).max_healthy_score, 1.0);
 }
 
 TEST(IndexCusumDrift, CoolerCyclesAreNotALeak) {
@@ -92,7 +75,7 @@ TEST(IndexCusumDrift, CoolerCyclesAreNotALeak) {
     for (const bool with_temp : {false, true}) {
       auto detector = make(both);
       auto rig = drifting_rig(cooler, with_temp);
-      const RunResult r = run(detector, rig, 2100.0);
+      const test::DetectorRun r = test::run_detector(detector, rig, 2100.0);
       EXPECT_LT(r.max_healthy_score, 1.0) << "p2 " << both << " temp " << with_temp;
     }
   }
@@ -110,7 +93,7 @@ TEST(IndexCusumDrift, ALeakDuringOrAfterTheCoolDownIsFound) {
       auto rig = drifting_rig(cool_down, with_temp);
       rig.onset = onset;
       rig.index_drop = 0.2;
-      const RunResult r = run(detector, rig, onset + 120.0);
+      const test::DetectorRun r = test::run_detector(detector, rig, onset + 120.0);
       SCOPED_TRACE(testing::Message() << "temp " << with_temp << " onset " << onset);
       EXPECT_LT(r.max_healthy_score, 1.0);
       EXPECT_GT(r.first_raise, onset);
@@ -130,7 +113,7 @@ TEST(IndexCusumDrift, SupplySetPointChangesAreNotALeak) {
     rig.report_supply = with_ps;
     rig.onset = 1200.0;
     rig.index_drop = 0.2;
-    const RunResult r = run(detector, rig, 1400.0);
+    const test::DetectorRun r = test::run_detector(detector, rig, 1400.0);
     std::printf("p2 %d ps %d: first raise %.1f, max healthy score %.2f\n", both, with_ps,
                 r.first_raise, r.max_healthy_score);
     SCOPED_TRACE(testing::Message() << "p2 " << both << " ps channel " << with_ps);
@@ -149,7 +132,7 @@ TEST(IndexCusumDrift, ADropBelowTheMinimumOfInterestIsNotAnAlarm) {
   test::SyntheticRig rig;
   rig.onset = 300.0;
   rig.index_drop = 0.01;
-  EXPECT_LT(run(detector, rig, 3900.0).first_raise, 0.0);
+  EXPECT_LT(test::run_detector(detector, rig, 3900.0).first_raise, 0.0);
 }
 
 // The drift paths (temperature regressor, supply steps, the reference ring) allocate nothing

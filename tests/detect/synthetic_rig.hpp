@@ -99,4 +99,30 @@ struct SyntheticRig {
   }
 };
 
+// What feeding a detector a stretch of the rig gave: the first hop whose score reached the raise
+// threshold (-1: none), the largest score before the rig's onset, and the last decision.
+struct DetectorRun {
+  double first_raise = -1.0;
+  double max_healthy_score = 0.0;
+  detect::Decision last;
+};
+
+// Feeds the detector the rig's observations until `seconds`; healthy hops are those before the
+// rig's onset.
+inline DetectorRun run_detector(detect::Detector& detector, SyntheticRig& rig, double seconds) {
+  DetectorRun result;
+  while (rig.t < seconds) {
+    const detect::Observation o = rig.next();
+    result.last = detector.update(o);
+    if (std::isnan(result.last.score)) continue;
+    if (o.t < rig.onset) {
+      result.max_healthy_score = std::max(result.max_healthy_score, result.last.score);
+    }
+    if (result.first_raise < 0 && result.last.score >= detector.raise_threshold()) {
+      result.first_raise = o.t;
+    }
+  }
+  return result;
+}
+
 }  // namespace leakmon::test
