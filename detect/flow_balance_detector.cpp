@@ -29,8 +29,8 @@ FlowBalanceDetector::FlowBalanceDetector(const FlowBalanceOptions& options, doub
           static_cast<std::size_t>(
               std::ceil(options.min_rest_fraction * static_cast<double>(block_hops_))),
           1)),
-      design_slope_(options.design_leak * std::sqrt(options.valve.supply_pressure) /
-                    options.valve_coefficient),
+      piston_area_(options.rig.A()),
+      design_slope_(options.design_leak * std::sqrt(options.rig.ps) / options.rig.Kv),
       sizing_decay_(std::exp(-options.block_seconds / options.sizing_seconds)),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)) {
   learned_.reserve(learn_hops_);
@@ -185,12 +185,12 @@ void FlowBalanceDetector::judge_block(double mean_residual, double mean_leak_ter
 }
 
 Decision FlowBalanceDetector::update(const Observation& o) {
-  const double ps = options_.valve.supply_pressure;
+  const double ps = options_.rig.ps;
   Hop hop;
   hop.speed = (o.x - previous_x_) / hop_seconds_;
   previous_x_ = o.x;
   hop.usable = !std::isnan(o.u) && !std::isnan(o.p1) && !std::isnan(o.p2) &&
-               !std::isnan(hop.speed) && std::abs(o.u) < 0.5 * options_.valve.command_full_scale;
+               !std::isnan(hop.speed) && std::abs(o.u) < 0.5 * options_.rig.u_max;
   if (hop.usable) {
     // Judged in the command's own units (fractions of full spool travel), on the side the
     // load makes the valve open to at rest (it feeds the leaks out of the loaded chamber): so
@@ -198,13 +198,12 @@ Decision FlowBalanceDetector::update(const Observation& o) {
     // orifice law read through the measured command would switch sides at the wrong place.
     // Load in units of ps, root factor in units of sqrt(ps).
     hop.load = (o.p1 - o.p2) / ps;
-    const double full_open = std::copysign(options_.valve.command_full_scale, hop.load);
+    const double full_open = std::copysign(options_.rig.u_max, hop.load);
     const double root =
-        std::abs(load_flow_per_kv(options_.valve, full_open, o.p1, o.p2)) / std::sqrt(ps);
+        std::abs(load_flow_per_kv(options_.rig, full_open, o.p1, o.p2)) / std::sqrt(ps);
     hop.usable = hop.usable && root > kMinRoot;
-    hop.opening =
-        o.u / options_.valve.command_full_scale -
-        options_.piston_area * hop.speed / (options_.valve_coefficient * std::sqrt(ps) * root);
+    hop.opening = o.u / options_.rig.u_max -
+                  piston_area_ * hop.speed / (options_.rig.Kv * std::sqrt(ps) * root);
     hop.leak_term = hop.load / root;
     hop.root = root;
   }
@@ -218,7 +217,7 @@ Decision FlowBalanceDetector::update(const Observation& o) {
 }
 
 void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
-  const double ps = options_.valve.supply_pressure;
+  const double ps = options_.rig.ps;
   Decision decision;
   ++hops_seen_;
   if (hops_seen_ <= settle_hops_) {
@@ -256,7 +255,7 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
                           : change_block_.ll > 0.0 ? change_block_
                                                    : weighted_;
   if (sums.ll > 0.0) {
-    const double to_leak = options_.valve_coefficient / std::sqrt(ps);
+    const double to_leak = options_.rig.Kv / std::sqrt(ps);
     const double slope = sums.rl / sums.ll;
     const double slope_se = block_sigma_ * std::sqrt(sums.ll_sq) / sums.ll;
     decision.leak_coefficient = slope * to_leak;

@@ -58,7 +58,7 @@ double IndexCusumDetector::log_index_of(const Observation& o) const {
 // Load pressure p1 - p2 over supply; with one chamber, that chamber's departure from mid-supply
 // (the two chambers mirror each other around it at rest).
 double IndexCusumDetector::load_of(const Observation& o) const {
-  const double ps = options_.supply_pressure;
+  const double ps = options_.rig.ps;
   if (!std::isnan(o.p1) && !std::isnan(o.p2)) return (o.p1 - o.p2) / ps;
   if (!std::isnan(o.p1)) return (2.0 * o.p1 - ps) / ps;
   if (!std::isnan(o.p2)) return (ps - 2.0 * o.p2) / ps;

@@ -13,13 +13,14 @@
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
 #include "detect/learning_schedule.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::detect {
 
 struct IndexCusumOptions {
   LearningSchedule learning;
   bool use_p1 = true, use_p2 = true;    // which chamber indices to use (if acquired)
-  double supply_pressure = 17.2e6;      // [Pa] scales the load pressure regressor
+  sim::Parameters rig;                  // its ps [Pa] scales the load pressure regressor
   double design_drop = 0.08;            // relative index drop the CUSUM is tuned for
   double false_alarms_per_hour = 0.05;  // sets the threshold
   double block_seconds = 0.8;           // one window (400 samples at 500 Hz)

@@ -2,6 +2,7 @@
 // valve_overlap dead band of the effect library.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 namespace leakmon::sim {
@@ -11,6 +12,13 @@ namespace leakmon::sim {
 inline double orifice(double dp, double dp_lin) noexcept {
   if (std::abs(dp) >= dp_lin) return std::copysign(std::sqrt(std::abs(dp)), dp);
   return dp / std::sqrt(dp_lin);
+}
+
+// d orifice(dp) / d dp: the slope Newton's method needs for the supply droop (supply.hpp).
+inline double orifice_slope(double dp, double dp_lin) noexcept {
+  const double magnitude = std::abs(dp);
+  if (magnitude >= dp_lin) return 0.5 / std::sqrt(magnitude);
+  return 1.0 / std::sqrt(dp_lin);
 }
 
 // valve_overlap: opening sign(o) max(|o| - d, 0), deliberately not rescaled (MODEL.md).

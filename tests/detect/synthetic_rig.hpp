@@ -10,6 +10,7 @@
 
 #include "detect/detector.hpp"
 #include "detect/valve_flow.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::test {
 
@@ -28,7 +29,7 @@ struct SyntheticRig {
   double overlap = 0.0;
   int crossing_hops = 0;
   double spring = 80e3, area = 6.334e-4;
-  detect::ValveGeometry valve;
+  sim::Parameters valve;  // the rig table: ps, pt, u_max, dp_lin
   std::mt19937_64 rng{1};
 
   double t = 0.0;
@@ -49,7 +50,7 @@ struct SyntheticRig {
     x += std::clamp(target - x, -0.01, 0.01);  // moves at up to 0.25 m/s, then rests
     const double leak_now = t >= onset ? leak : 0.0;
     const double dp = spring * x / area;
-    const double p_mid = 0.5 * (valve.supply_pressure + valve.tank_pressure);
+    const double p_mid = 0.5 * (valve.ps + valve.pt);
     detect::Observation o;
     o.t = t;
     o.p1 = p_mid + dp / 2 + 2e3 * normal(rng);
@@ -58,16 +59,16 @@ struct SyntheticRig {
     // Command whose load flow (valve_flow.hpp) feeds the leak, the null leak and the motion.
     const double flow = (leak_now + null_leak) * dp + area * (x - previous_x) / hop;
     const double per_opening = std::abs(detect::load_flow_per_kv(
-        valve, std::copysign(valve.command_full_scale, flow), p_mid + dp / 2, p_mid - dp / 2));
+        valve, std::copysign(valve.u_max, flow), p_mid + dp / 2, p_mid - dp / 2));
     const double opening = flow / (kv * per_opening);
     const bool arrived_across = x == target && previous_x != x && previous_x * x < 0.0;
     if (arrived_across) crossing_left = crossing_hops;
     const double spool = crossing_left > 0 ? 0.0 : opening + std::copysign(overlap, opening);
     if (crossing_left > 0) --crossing_left;
-    o.u = valve.command_full_scale * spool - command_offset + 1e-3 * normal(rng);
+    o.u = valve.u_max * spool - command_offset + 1e-3 * normal(rng);
     // Index: load-dependent level, AR(1) with about one window of memory, drop after onset.
     window_level = 0.95 * window_level + std::sqrt(1 - 0.95 * 0.95) * index_noise * normal(rng);
-    const double load = dp / valve.supply_pressure;
+    const double load = dp / valve.ps;
     const double log_index = std::log(30e3) - 0.8 * load * load + 0.1 * load + window_level +
                              (t >= onset ? std::log1p(-index_drop) : 0.0);
     o.index_p1 = std::exp(log_index + 0.02 * normal(rng));
