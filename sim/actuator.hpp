@@ -53,8 +53,9 @@ struct ActuatorFlows {
 
 // p1, p2 already clamped at 0 (no cavitation); w is the spool flow noise, C_L the internal
 // leakage coefficient in force at t.
-inline ActuatorFlows actuator_flows(const ActuatorCoefficients& c, double t, double xs, double w,
-                                    double C_L, double p1, double p2) noexcept {
+[[gnu::always_inline]] inline ActuatorFlows actuator_flows(const ActuatorCoefficients& c, double t,
+                                                           double xs, double w, double C_L,
+                                                           double p1, double p2) noexcept {
   ActuatorFlows f{};
   f.opening = xs + w;
   if (c.overlap > 0.0) f.opening = overlapped_opening(f.opening, c.overlap);
@@ -86,9 +87,11 @@ struct ActuatorRates {
 
 // spool_in = spool_command(u + u0, u_max), constant while u is held. p1_state, p2_state are the
 // integrated pressures (an RK stage may dip below 0; the equations see them clamped).
-inline ActuatorRates actuator_rates(const ActuatorCoefficients& c, double t, double spool_in,
-                                    double w, double C_L, double xs, double x, double v,
-                                    double p1_state, double p2_state) noexcept {
+[[gnu::always_inline]] inline ActuatorRates actuator_rates(const ActuatorCoefficients& c, double t,
+                                                           double spool_in, double w, double C_L,
+                                                           double xs, double x, double v,
+                                                           double p1_state,
+                                                           double p2_state) noexcept {
   const double p1 = std::max(p1_state, 0.0);
   const double p2 = std::max(p2_state, 0.0);
   const ActuatorFlows f = actuator_flows(c, t, xs, w, C_L, p1, p2);
