@@ -1,9 +1,11 @@
 #include "daemon/actuator_monitor.hpp"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "detect/factory.hpp"
 
@@ -49,7 +51,19 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       detector_(build_detector(config, layout, period_ns)),
       alarm_(effective(config.alarm)),
       activity_(config.features.window, kNaN),
-      index_input_(layout.p2 >= 0 ? 2 : 1, kNaN) {}
+      index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
+      sample_rate_hz_(1e9 / static_cast<double>(period_ns)) {
+  const double rate = sample_rate_hz_;
+  channels_.reserve(3);
+  for (auto [role, index, spec, slot] :
+       {std::tuple{"p1", layout.p1, &config.p1_transducer, &check_p1_},
+        std::tuple{"p2", layout.p2, &config.p2_transducer, &check_p2_},
+        std::tuple{"x", layout.x, &config.x_transducer, &check_x_}}) {
+    if (index < 0) continue;
+    *slot = static_cast<int>(channels_.size());
+    channels_.push_back(Channel{role, index, detect::SensorPlausibility(*spec, rate)});
+  }
+}
 
 AlarmSettings ActuatorMonitor::effective(const AlarmSettings& configured) const {
   AlarmSettings settings = configured;
@@ -63,43 +77,106 @@ void ActuatorMonitor::set_alarm_settings(const AlarmSettings& settings) {
   alarm_.set_settings(effective(settings));
 }
 
+void ActuatorMonitor::set_transducers(const ActuatorConfig& config) {
+  config_.p1_transducer = config.p1_transducer;
+  config_.p2_transducer = config.p2_transducer;
+  config_.x_transducer = config.x_transducer;
+  for (auto& channel : channels_) {
+    const std::string_view role = channel.role;
+    const auto& spec = role == "p1"   ? config_.p1_transducer
+                       : role == "p2" ? config_.p2_transducer
+                                      : config_.x_transducer;
+    channel.check.reconfigure(spec, sample_rate_hz_);
+  }
+}
+
 bool ActuatorMonitor::same_pipeline(const ActuatorConfig& other,
                                     const ChannelLayout& other_layout) const {
   const auto& a = config_.features;
   const auto& b = other.features;
   return layout_.p1 == other_layout.p1 && layout_.p2 == other_layout.p2 &&
          layout_.u == other_layout.u && layout_.x == other_layout.x &&
-         layout_.xref == other_layout.xref && a.wavelet == b.wavelet && a.level == b.level &&
+         layout_.xref == other_layout.xref && layout_.ps == other_layout.ps &&
+         layout_.temp == other_layout.temp && a.wavelet == b.wavelet && a.level == b.level &&
          a.window == b.window && a.step == b.step && a.mode == b.mode &&
          config_.detector == other.detector &&
          yaml_text(config_.detector_options) == yaml_text(other.detector_options);
 }
 
 bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) {
-  const double p1 = value_at(sample, layout_.p1);
-  const double p2 = value_at(sample, layout_.p2);
+  // Every checked channel releases its cleaned value of kDelay samples ago; u, xref and t wait
+  // in delay_ for as long.
+  constexpr std::size_t kDelay = detect::SensorPlausibility::kDelay;
+  double cleaned[3] = {kNaN, kNaN, kNaN};
+  bool suspect = false;
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    auto& channel = channels_[i];
+    cleaned[i] = channel.check.push(value_at(sample, channel.index));
+    suspect |= channel.check.suspect();
+  }
+  check_sensor_faults(sample.t, publish);
+  delay_[arrived_ % delay_.size()] = {sample.t, value_at(sample, layout_.u),
+                                      value_at(sample, layout_.xref), value_at(sample, layout_.ps),
+                                      value_at(sample, layout_.temp)};
+  ++arrived_;
+  if (arrived_ <= kDelay) return false;
+  const Unchecked& unchecked = delay_[(arrived_ - 1 - kDelay) % delay_.size()];
+  ++fed_;
+  // A suspect channel's samples leave the features' window only a window and a hop later.
+  if (suspect) blocked_until_ = fed_ + config_.features.window + config_.features.step;
+
+  auto checked = [&](int slot) { return slot < 0 ? kNaN : cleaned[slot]; };
+  const double p1 = checked(check_p1_);
+  const double p2 = checked(check_p2_);
+  const double x = checked(check_x_);
   index_input_[0] = p1;
   if (index_input_.size() > 1) index_input_[1] = p2;
   if (std::isnan(p1)) ++gap_samples_;
 
   if (hop_samples_ >= config_.features.step) {
-    hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = HopMean{};
+    hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = hop_ps_ = hop_temp_ = HopMean{};
     hop_samples_ = 0;
   }
-  hop_u_.add(value_at(sample, layout_.u));
-  hop_x_.add(value_at(sample, layout_.x));
+  hop_u_.add(unchecked.u);
+  hop_x_.add(x);
   hop_p1_.add(p1);
   hop_p2_.add(p2);
+  hop_ps_.add(unchecked.ps);
+  hop_temp_.add(unchecked.temp);
   ++hop_samples_;
 
-  const int activity_channel = layout_.xref >= 0 ? layout_.xref : layout_.x;
-  activity_[activity_next_] = value_at(sample, activity_channel);
+  activity_[activity_next_] = layout_.xref >= 0 ? unchecked.xref : x;
   activity_next_ = (activity_next_ + 1) % activity_.size();
   if (activity_filled_ < activity_.size()) ++activity_filled_;
 
   if (!features_.push(index_input_)) return false;
-  decide(sample.t, publish);
+  decide(unchecked.t, publish);
   return true;
+}
+
+void ActuatorMonitor::check_sensor_faults(double t, const EventPublisher& publish) {
+  for (auto& channel : channels_) {
+    const detect::SensorFault fault = channel.check.fault();
+    if (fault == channel.announced) continue;
+    io::Event event;
+    event.t = t;
+    event.actuator = config_.name;
+    event.alarm = "sensor_fault";
+    event.channel = channel.role;
+    if (channel.announced != detect::SensorFault::none) {
+      event.kind = io::EventKind::alarm_cleared;
+      event.fault = std::string(detect::to_string(channel.announced));
+      publish(event);
+    }
+    if (fault != detect::SensorFault::none) {
+      event.kind = io::EventKind::alarm_raised;
+      event.fault = std::string(detect::to_string(fault));
+      event.message = fmt::format("{} {}: {} ({})", config_.name, channel.role, event.fault,
+                                  io::to_string(detect::device_status(fault)));
+      publish(event);
+    }
+    channel.announced = fault;
+  }
 }
 
 void ActuatorMonitor::push_gap(double t, const EventPublisher& publish) {
@@ -123,6 +200,8 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   observation.x = mean(hop_x_, layout_.x);
   observation.p1 = mean(hop_p1_, layout_.p1);
   observation.p2 = mean(hop_p2_, layout_.p2);
+  observation.ps = mean(hop_ps_, layout_.ps);
+  observation.temp = mean(hop_temp_, layout_.temp);
   if ((layout_.xref >= 0 || layout_.x >= 0) && activity_filled_ == activity_.size()) {
     double sum = 0.0;
     for (double v : activity_) sum += v;
@@ -131,27 +210,33 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
     for (double v : activity_) squares += (v - m) * (v - m);
     observation.x_activity = std::sqrt(squares / static_cast<double>(activity_.size()));
   }
-  hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = HopMean{};
+  hop_u_ = hop_x_ = hop_p1_ = hop_p2_ = hop_ps_ = hop_temp_ = HopMean{};
   hop_samples_ = 0;
-
-  last_decision_ = detector_->update(observation);
   last_t_ = t;
+  if (!std::isnan(observation.temp)) last_temperature_ = observation.temp;
+
+  // A faulty or suspect channel: neither decide nor learn; the score and the alarm hold.
+  if (fed_ < blocked_until_) {
+    ++suspended_decisions_;
+    return;
+  }
+  last_decision_ = detector_->update(observation);
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
-  if (transition.raised) publish(alarm_event(EventKind::alarm_raised, t));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, t));
+  if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, t));
 }
 
 void ActuatorMonitor::acknowledge(const EventPublisher& publish) {
   const AlarmTransition transition = alarm_.acknowledge();
-  if (transition.acknowledged) publish(alarm_event(EventKind::alarm_acknowledged, last_t_));
-  if (transition.cleared) publish(alarm_event(EventKind::alarm_cleared, last_t_));
+  if (transition.acknowledged) publish(alarm_event(io::EventKind::alarm_acknowledged, last_t_));
+  if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, last_t_));
 }
 
-Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
-  Event event;
+io::Event ActuatorMonitor::alarm_event(io::EventKind kind, double t) const {
+  io::Event event;
   event.kind = kind;
   event.t = t;
   event.actuator = config_.name;
@@ -166,11 +251,15 @@ Event ActuatorMonitor::alarm_event(EventKind kind, double t) const {
     event.leak_coefficient = c;
     event.leak_lpm_per_mpa = c * kLpmPerM3s * 1e6;
     event.load_pressure = last_load_pressure_;
-    event.leak_lpm = c * last_load_pressure_ * kLpmPerM3s;
+    // The coefficient is stated at 40 degC when the oil temperature is known; the flow is the
+    // one at the present temperature and load.
+    const double r =
+        std::isfinite(last_decision_.viscosity_ratio) ? last_decision_.viscosity_ratio : 1.0;
+    event.leak_lpm = c * r * last_load_pressure_ * kLpmPerM3s;
     const double half_width = last_decision_.leak_coefficient_ci;
     if (std::isfinite(half_width)) {
       event.leak_lpm_per_mpa_ci95 = half_width * kLpmPerM3s * 1e6;
-      event.leak_lpm_ci95 = half_width * last_load_pressure_ * kLpmPerM3s;
+      event.leak_lpm_ci95 = half_width * r * last_load_pressure_ * kLpmPerM3s;
     }
   }
   return event;
@@ -190,8 +279,16 @@ ActuatorStatus ActuatorMonitor::status() const {
   status.score = last_decision_.score;
   status.baseline = last_decision_.baseline;
   status.leak_coefficient = last_decision_.leak_coefficient;
+  status.leak_coefficient_ci = last_decision_.leak_coefficient_ci;
+  status.oil_temperature = last_temperature_;
   status.decisions = decisions_;
   status.gap_samples = gap_samples_;
+  status.suspended = fed_ < blocked_until_;
+  status.suspended_decisions = suspended_decisions_;
+  for (const auto& channel : channels_) {
+    status.channels.push_back({channel.role, channel.check.status(), channel.check.fault(),
+                               channel.check.spikes_rejected()});
+  }
   return status;
 }
 

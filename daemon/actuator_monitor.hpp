@@ -1,8 +1,16 @@
 // One actuator's path from samples to alarm events: streaming wavelet index of p1 (and p2),
 // the hop summary the detector needs (detect::Observation), the detector, and the alarm state
-// machine. Runs on the worker thread; allocates only when built.
+// machine. Runs on the worker thread; allocates only when built (and when it publishes an event).
+//
+// Before the index, every transducer channel (p1, p2, x) passes its plausibility check
+// (detect::SensorPlausibility): isolated spikes are replaced by the median of their neighbours,
+// so the whole pipeline runs SensorPlausibility::kDelay samples (4 ms at 500 Hz) behind the
+// newest sample. A frozen, saturated, spiking or dropped-out channel raises a `sensor_fault`
+// alarm naming it, and while any channel is faulty or suspect the detector is not fed (its score
+// and learned state are held) until a full window of plausible data has passed again.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -11,16 +19,25 @@
 
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event.hpp"
 #include "daemon/sample.hpp"
 #include "detect/detector.hpp"
+#include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
 // Where each role's value sits in a group's Sample; -1 when the actuator does not acquire it.
 struct ChannelLayout {
-  int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1;
+  int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1, ps = -1, temp = -1;
+};
+
+// One transducer channel's plausibility, for the metrics and `leakmon status`.
+struct ChannelHealth {
+  std::string channel;  // role: p1, p2, x
+  io::DeviceStatus status = io::DeviceStatus::ok;
+  detect::SensorFault fault = detect::SensorFault::none;  // also while recovering
+  std::uint64_t spikes_rejected = 0;
 };
 
 // What the metrics and `leakmon status` show for one actuator.
@@ -30,17 +47,22 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
-  double t = kNoValue;         // source time of the newest decision
-  double index_p1 = kNoValue;  // Pa
-  double index_p2 = kNoValue;
-  double score = kNoValue;
-  double baseline = kNoValue;
-  double leak_coefficient = kNoValue;
+  double t = io::kNoValue;         // source time of the newest decision
+  double index_p1 = io::kNoValue;  // Pa
+  double index_p2 = io::kNoValue;
+  double score = io::kNoValue;
+  double baseline = io::kNoValue;
+  double leak_coefficient = io::kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
+  double leak_coefficient_ci = io::kNoValue;  // its 95 % half-width
+  double oil_temperature = io::kNoValue;      // degC, newest hop mean of the `temp` channel
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
+  std::vector<ChannelHealth> channels;
+  bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
+  std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
 };
 
-using EventPublisher = std::function<void(const Event&)>;
+using EventPublisher = std::function<void(const io::Event&)>;
 
 class ActuatorMonitor {
  public:
@@ -59,6 +81,8 @@ class ActuatorMonitor {
   void acknowledge(const EventPublisher& publish);
   // Adopt new alarm settings (reload) without losing state.
   void set_alarm_settings(const AlarmSettings& settings);
+  // Adopt new transducer settings (reload): the plausibility checks keep their state.
+  void set_transducers(const ActuatorConfig& config);
   // True when `other` can take over this monitor's learned state (same signals and features).
   bool same_pipeline(const ActuatorConfig& other, const ChannelLayout& other_layout) const;
 
@@ -66,7 +90,8 @@ class ActuatorMonitor {
 
  private:
   void decide(double t, const EventPublisher& publish);
-  Event alarm_event(EventKind kind, double t) const;
+  io::Event alarm_event(io::EventKind kind, double t) const;
+  void check_sensor_faults(double t, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
 
   ActuatorConfig config_;
@@ -84,7 +109,7 @@ class ActuatorMonitor {
       sum += v;
     }
   };
-  HopMean hop_u_, hop_x_, hop_p1_, hop_p2_;
+  HopMean hop_u_, hop_x_, hop_p1_, hop_p2_, hop_ps_, hop_temp_;
   std::size_t hop_samples_ = 0;
   // Ring of the excitation signal (xref, else x) over the window, for Observation::x_activity.
   std::vector<double> activity_;
@@ -92,9 +117,30 @@ class ActuatorMonitor {
   std::size_t activity_filled_ = 0;
   std::vector<double> index_input_;  // scratch: the index channels of one sample
 
+  // Plausibility of the transducer channels the layout has, and the fault each has announced.
+  struct Channel {
+    const char* role;
+    int index;
+    detect::SensorPlausibility check;
+    detect::SensorFault announced = detect::SensorFault::none;
+  };
+  std::vector<Channel> channels_;
+  double sample_rate_hz_;
+  int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
+  // u, xref and t delayed like the checked channels, so one sample stays one instant.
+  struct Unchecked {
+    double t, u, xref, ps, temp;
+  };
+  std::array<Unchecked, detect::SensorPlausibility::kDelay + 1> delay_{};
+  std::uint64_t arrived_ = 0;        // samples pushed (raw)
+  std::uint64_t fed_ = 0;            // delayed samples given to the features
+  std::uint64_t blocked_until_ = 0;  // no detector update before this many samples are fed
+  std::uint64_t suspended_decisions_ = 0;
+
   detect::Decision last_decision_;
-  double last_t_ = kNoValue;
-  double last_load_pressure_ = kNoValue;
+  double last_t_ = io::kNoValue;
+  double last_load_pressure_ = io::kNoValue;
+  double last_temperature_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
 };

@@ -32,9 +32,10 @@ void CaptureRecorder::open(double t) {
   for (int n = 1; fs::exists(path); ++n) {
     path = (fs::path(config_.directory) / fmt::format("{}-{}-{}.csv", group_, stamp, n)).string();
   }
-  io::Metadata metadata{{"sample_rate_hz", fmt::format("{}", sample_rate_hz_)},
-                        {"source", fmt::format("leakmon recording, sampling group {}", group_)}};
-  writer_ = std::make_unique<io::CaptureWriter>(path, columns_, metadata);
+  capture::Metadata metadata{
+      {"sample_rate_hz", fmt::format("{}", sample_rate_hz_)},
+      {"source", fmt::format("leakmon recording, sampling group {}", group_)}};
+  writer_ = std::make_unique<capture::CaptureWriter>(path, columns_, metadata);
   file_start_t_ = t;
   files_.push_back(path);
   prune();

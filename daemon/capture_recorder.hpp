@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "daemon/config.hpp"
 #include "daemon/sample.hpp"
-#include "io/capture/capture.hpp"
 
 namespace leakmon::daemon {
 
@@ -41,7 +41,7 @@ class CaptureRecorder {
   std::vector<std::string> columns_;
   double sample_rate_hz_;
   RecordingConfig config_;
-  std::unique_ptr<io::CaptureWriter> writer_;
+  std::unique_ptr<capture::CaptureWriter> writer_;
   double file_start_t_ = 0.0;
   std::int64_t last_flush_ns_ = 0;
   std::vector<double> row_;

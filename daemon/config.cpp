@@ -95,21 +95,55 @@ AlarmSettings parse_alarm(const config::ConfigNode& node) {
   return alarm;
 }
 
+// One `transducers:` entry; what is left out keeps `spec`'s value. `bits` sets the resolution
+// to the range over 2^bits (only for a finite range); `resolution` sets it directly.
+detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
+                                        detect::TransducerSpec spec) {
+  node.expect_keys({"check", "min", "max", "bits", "resolution", "noise_sigma"});
+  spec.enabled = node.get_bool("check", spec.enabled);
+  spec.min = node.get_double("min", spec.min, -1e12, 1e12);
+  spec.max = node.get_double("max", spec.max, -1e12, 1e12);
+  if (!(spec.max > spec.min)) {
+    node.fail(fmt::format("max {} must be above min {}", spec.max, spec.min));
+  }
+  if (node.has("bits") && node.has("resolution")) {
+    node.at("resolution").fail("give either bits or resolution, not both");
+  }
+  if (node.has("bits")) {
+    if (!std::isfinite(spec.min) || !std::isfinite(spec.max)) {
+      node.at("bits").fail("bits needs a finite range: give min and max (or resolution)");
+    }
+    const auto bits = node.get_int("bits", 1, 32);
+    spec.resolution = (spec.max - spec.min) / std::ldexp(1.0, static_cast<int>(bits));
+  } else if (node.has("resolution")) {
+    spec.resolution = node.get_double("resolution", 0.0, 1e12);
+  } else if (node.has("min") || node.has("max")) {
+    // A new range keeps the default's bit count (12) rather than its LSB in pascals.
+    if (std::isfinite(spec.min) && std::isfinite(spec.max)) {
+      spec.resolution = (spec.max - spec.min) / 4096.0;
+    }
+  }
+  spec.noise_sigma = node.get_double("noise_sigma", spec.noise_sigma, 0.0, 1e12);
+  return spec;
+}
+
 ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
                               std::set<std::string>& names) {
-  node.expect_keys({"name", "channels", "features", "detector", "alarm"});
+  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers"});
   ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
-  channels.expect_keys({"p1", "p2", "u", "x", "xref"});
+  channels.expect_keys({"p1", "p2", "u", "x", "xref", "ps", "temp"});
   actuator.p1 = parse_channel_ref(channels.at("p1"), config);
   for (auto [role, ref] : {std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
+                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
+                           std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
     if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
   }
   // One actuator's signals must be sampled together (one group, one clock).
   const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
-  for (const auto* ref : {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+  for (const auto* ref :
+       {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref, &actuator.ps, &actuator.temp}) {
     if (ref->present() && group_of_driver(config, ref->driver) != group) {
       channels.fail(
           fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
@@ -135,6 +169,14 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   if (auto alarm = node.find("alarm")) {
     actuator.alarm = parse_alarm(*alarm);
     actuator.alarm_name = alarm->get_string("name", actuator.alarm_name);
+  }
+  if (auto transducers = node.find("transducers")) {
+    transducers->expect_keys({"p1", "p2", "x"});
+    for (auto [role, spec] :
+         {std::pair{"p1", &actuator.p1_transducer}, std::pair{"p2", &actuator.p2_transducer},
+          std::pair{"x", &actuator.x_transducer}}) {
+      if (auto n = transducers->find(role)) *spec = parse_transducer(*n, *spec);
+    }
   }
   return actuator;
 }
@@ -286,7 +328,8 @@ void check_channels(const DaemonConfig& config,
     }
   }
   for (const auto& actuator : config.actuators) {
-    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
+                            &actuator.ps, &actuator.temp}) {
       if (!ref->present()) continue;
       const auto& names = channels_of(ref->driver);
       if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;

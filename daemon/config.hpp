@@ -11,6 +11,7 @@
 
 #include "config/yaml_reader.hpp"
 #include "daemon/alarm.hpp"
+#include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
 
 namespace leakmon::daemon {
@@ -44,13 +45,18 @@ struct ChannelRef {
 struct ActuatorConfig {
   std::string name;
   // Signals by role; p1 is required, the others optional (MODEL.md names).
-  ChannelRef p1, p2, u, x, xref;
+  ChannelRef p1, p2, u, x, xref, ps, temp;
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   std::string alarm_name = "internal_leakage";
+  // The transducers behind p1, p2 and x, for their plausibility checks (`transducers:`);
+  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise.
+  detect::TransducerSpec p1_transducer = detect::TransducerSpec::pressure();
+  detect::TransducerSpec p2_transducer = detect::TransducerSpec::pressure();
+  detect::TransducerSpec x_transducer = detect::TransducerSpec::position();
 };
 
 struct RecordingConfig {

@@ -7,7 +7,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
-#include <cmath>
 #include <ctime>
 
 #include "daemon/driver_registry.hpp"
@@ -55,51 +54,22 @@ std::string acquisition_signature(const DaemonConfig& config) {
   return text;
 }
 
-std::string label(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    out += c;
-  }
-  return out;
-}
-
-void histogram(std::string& out, std::string_view name, std::string_view labels,
-               const LatencyHistogram& h) {
-  static constexpr double kBucketsSeconds[] = {10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6,
-                                               1e-3,  2e-3,  5e-3,  10e-3,  20e-3};
-  const std::string sep = labels.empty() ? "" : ",";
-  for (double le : kBucketsSeconds) {
-    out += fmt::format("{}_bucket{{{}{}le=\"{}\"}} {}\n", name, labels, sep, le,
-                       h.count_below(static_cast<std::int64_t>(std::llround(le * 1e9))));
-  }
-  out += fmt::format("{}_bucket{{{}{}le=\"+Inf\"}} {}\n", name, labels, sep, h.count());
-  out += fmt::format("{}_sum{{{}}} {}\n", name, labels, static_cast<double>(h.sum_ns()) / 1e9);
-  out += fmt::format("{}_count{{{}}} {}\n", name, labels, h.count());
-}
-
-std::string number(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "NaN"; }
-
 }  // namespace
 
 Daemon::Daemon(std::string config_path) : config_path_(std::move(config_path)) {}
 
 Daemon::~Daemon() { stop(); }
 
-std::vector<std::unique_ptr<EventSink>> Daemon::build_sinks(const DaemonConfig& config) const {
-  std::vector<std::unique_ptr<EventSink>> sinks;
+std::vector<std::unique_ptr<io::EventSink>> Daemon::build_sinks(const DaemonConfig& config) const {
+  std::vector<std::unique_ptr<io::EventSink>> sinks;
   sinks.push_back(std::make_unique<LogEventSink>());
   if (!config.event_log.empty()) sinks.push_back(std::make_unique<JsonlEventLog>(config.event_log));
   for (const auto& node : config.outputs) sinks.push_back(make_output(node));
   return sinks;
 }
 
-std::vector<EventSink*> Daemon::raw(const std::vector<std::unique_ptr<EventSink>>& sinks) {
-  std::vector<EventSink*> out;
+std::vector<io::EventSink*> Daemon::raw(const std::vector<std::unique_ptr<io::EventSink>>& sinks) {
+  std::vector<io::EventSink*> out;
   for (const auto& s : sinks) out.push_back(s.get());
   return out;
 }
@@ -260,8 +230,8 @@ void Daemon::housekeeping(std::int64_t now_ns) {
       const auto& counters = groups_[i]->loop->counters();
       const std::uint64_t overruns = counters.overruns.load();
       if (overruns == reported_overruns_[i]) continue;
-      Event event;
-      event.kind = EventKind::overrun;
+      io::Event event;
+      event.kind = io::EventKind::overrun;
       event.channel = groups_[i]->config.name;
       event.message =
           fmt::format("{} overrun(s), {} missed cycle(s) in total, {} ring drop(s)", overruns,
@@ -274,16 +244,18 @@ void Daemon::housekeeping(std::int64_t now_ns) {
   for (std::size_t i = 0; i < drivers_.size(); ++i) {
     const io::DriverHealth health = drivers_[i]->health();
     DriverWatch& watch = driver_watch_[i];
-    if (health.state != watch.state) {
-      Event event;
-      event.kind = health.state == "ok" ? EventKind::driver_recovered : EventKind::driver_fault;
+    if (health.status != watch.status || health.detail != watch.detail) {
+      io::Event event;
+      event.kind = health.status == io::DeviceStatus::ok ? io::EventKind::driver_recovered
+                                                         : io::EventKind::driver_fault;
       event.channel = drivers_[i]->name();
-      event.message = fmt::format("state {} -> {}{}{}", watch.state, health.state,
+      event.message = fmt::format("state {} -> {} (NE 107 {}){}{}", watch.detail, health.detail,
+                                  io::to_string(health.status),
                                   health.last_error.empty() ? "" : ": ", health.last_error);
       worker_->publish(event);
-      watch.state = health.state;
+      watch.status = health.status;
+      watch.detail = health.detail;
     }
-    watch.errors = health.errors;
   }
   const auto interval = notifier_.watchdog_interval();
   if (interval.count() > 0 && now_ns - last_watchdog_ns_ >= interval.count() * 1000 / 4) {
@@ -295,7 +267,7 @@ void Daemon::housekeeping(std::int64_t now_ns) {
 void Daemon::reload() {
   notifier_.reloading();
   spdlog::info("SIGHUP: reloading {}", config_path_);
-  Event event;
+  io::Event event;
   try {
     DaemonConfig next = check_config(config_path_);
     if (acquisition_signature(next) != acquisition_signature(config_)) {
@@ -311,13 +283,13 @@ void Daemon::reload() {
     config_ = std::move(next);
     ++reloads_;
     last_reload_ok_ = true;
-    event.kind = EventKind::config_reloaded;
+    event.kind = io::EventKind::config_reloaded;
     event.message = config_path_;
   } catch (const std::exception& e) {
     ++reload_failures_;
     last_reload_ok_ = false;
     spdlog::error("reload rejected, the running configuration stays: {}", e.what());
-    event.kind = EventKind::config_rejected;
+    event.kind = io::EventKind::config_rejected;
     event.message = e.what();
   }
   last_reload_unix_ = static_cast<std::int64_t>(std::time(nullptr));
@@ -375,167 +347,6 @@ HttpResponse Daemon::handle(const HttpRequest& request) {
     return {200, "text/plain", fmt::format("acknowledged {} actuator(s)\n", matched)};
   }
   return {404, "text/plain", "try /metrics, /status or POST /ack\n"};
-}
-
-std::string Daemon::metrics_text() const {
-  std::string out;
-  out += "# HELP leakmon_build_info leakmon version\n# TYPE leakmon_build_info gauge\n";
-  out += fmt::format("leakmon_build_info{{version=\"{}\"}} 1\n", LEAKMON_VERSION);
-
-  out +=
-      "# HELP leakmon_loop_wakeup_latency_seconds acquisition loop wake-up minus schedule\n"
-      "# TYPE leakmon_loop_wakeup_latency_seconds histogram\n";
-  for (const auto& g : groups_) {
-    histogram(out, "leakmon_loop_wakeup_latency_seconds",
-              fmt::format("group=\"{}\"", label(g->config.name)),
-              g->loop->counters().wakeup_latency);
-  }
-  auto counter = [&](std::string_view name, std::string_view help, std::string_view type,
-                     auto value_of) {
-    out += fmt::format("# HELP {} {}\n# TYPE {} {}\n", name, help, name, type);
-    for (const auto& g : groups_) {
-      out += fmt::format("{}{{group=\"{}\"}} {}\n", name, label(g->config.name), value_of(*g));
-    }
-  };
-  counter("leakmon_loop_cycles_total", "acquisition cycles run", "counter",
-          [](const Group& g) { return g.loop->counters().cycles.load(); });
-  counter("leakmon_loop_overruns_total", "late wake-ups that skipped a period", "counter",
-          [](const Group& g) { return g.loop->counters().overruns.load(); });
-  counter("leakmon_loop_missed_cycles_total", "periods skipped by overruns", "counter",
-          [](const Group& g) { return g.loop->counters().missed_cycles.load(); });
-  counter("leakmon_ring_drops_total", "samples dropped because the ring was full", "counter",
-          [](const Group& g) { return g.loop->counters().ring_drops.load(); });
-  counter("leakmon_ring_high_water", "most samples ever queued in the ring", "gauge",
-          [](const Group& g) { return g.loop->counters().ring_high_water.load(); });
-  counter("leakmon_ring_capacity", "ring capacity in samples", "gauge",
-          [](const Group& g) { return g.ring->capacity(); });
-  counter("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
-          [](const Group& g) { return g.realtime.fifo ? 1 : 0; });
-
-  out +=
-      "# HELP leakmon_cpu_wakeup_latency_request_held 1 while the CPU wake-up latency request "
-      "(/dev/cpu_dma_latency) is held\n"
-      "# TYPE leakmon_cpu_wakeup_latency_request_held gauge\n";
-  out += fmt::format("leakmon_cpu_wakeup_latency_request_held {}\n", cpu_latency_.held() ? 1 : 0);
-  out +=
-      "# HELP leakmon_samples_processed_total samples the worker consumed\n"
-      "# TYPE leakmon_samples_processed_total counter\n";
-  out += fmt::format("leakmon_samples_processed_total {}\n", worker_->samples_processed());
-  out += "# HELP leakmon_events_total events published\n# TYPE leakmon_events_total counter\n";
-  out += fmt::format("leakmon_events_total {}\n", worker_->events_published());
-  out +=
-      "# HELP leakmon_decision_latency_seconds sample acquisition to decision and events\n"
-      "# TYPE leakmon_decision_latency_seconds histogram\n";
-  histogram(out, "leakmon_decision_latency_seconds", "", worker_->decision_latency());
-
-  const auto actuators = worker_->status();
-  out +=
-      "# HELP leakmon_index_pascal newest wavelet index (db8 level-2 detail RMS)\n"
-      "# TYPE leakmon_index_pascal gauge\n";
-  for (const auto& a : actuators) {
-    out += fmt::format("leakmon_index_pascal{{actuator=\"{}\",channel=\"p1\"}} {}\n", label(a.name),
-                       number(a.index_p1));
-    if (std::isfinite(a.index_p2)) {
-      out += fmt::format("leakmon_index_pascal{{actuator=\"{}\",channel=\"p2\"}} {}\n",
-                         label(a.name), number(a.index_p2));
-    }
-  }
-  out +=
-      "# HELP leakmon_detector_score newest detector score\n# TYPE leakmon_detector_score gauge\n";
-  for (const auto& a : actuators) {
-    out += fmt::format("leakmon_detector_score{{actuator=\"{}\",detector=\"{}\"}} {}\n",
-                       label(a.name), label(a.detector), number(a.score));
-  }
-  out +=
-      "# HELP leakmon_detector_learning 1 while the detector learns the healthy baseline\n"
-      "# TYPE leakmon_detector_learning gauge\n";
-  for (const auto& a : actuators) {
-    out += fmt::format("leakmon_detector_learning{{actuator=\"{}\"}} {}\n", label(a.name),
-                       a.learning ? 1 : 0);
-  }
-  out +=
-      "# HELP leakmon_alarm_active 1 while the alarm is annunciated\n"
-      "# TYPE leakmon_alarm_active gauge\n";
-  for (const auto& a : actuators) {
-    out += fmt::format("leakmon_alarm_active{{actuator=\"{}\",alarm=\"{}\",state=\"{}\"}} {}\n",
-                       label(a.name), label(a.alarm), to_string(a.state),
-                       a.state == AlarmState::normal ? 0 : 1);
-  }
-  out +=
-      "# HELP leakmon_driver_errors_total driver communication errors\n"
-      "# TYPE leakmon_driver_errors_total counter\n";
-  std::string up, reconnects, stale;
-  for (const auto& d : drivers_) {
-    const auto health = d->health();
-    out += fmt::format("leakmon_driver_errors_total{{driver=\"{}\"}} {}\n", label(d->name()),
-                       health.errors);
-    up += fmt::format("leakmon_driver_up{{driver=\"{}\",state=\"{}\"}} {}\n", label(d->name()),
-                      label(health.state), health.state == "ok" ? 1 : 0);
-    reconnects += fmt::format("leakmon_driver_reconnects_total{{driver=\"{}\"}} {}\n",
-                              label(d->name()), health.reconnects);
-    stale += fmt::format("leakmon_driver_stale_values_total{{driver=\"{}\"}} {}\n",
-                         label(d->name()), health.stale_values);
-  }
-  out +=
-      "# HELP leakmon_driver_up 1 when the driver reports state ok\n# TYPE leakmon_driver_up "
-      "gauge\n" +
-      up;
-  out +=
-      "# HELP leakmon_driver_reconnects_total driver reconnects\n# TYPE "
-      "leakmon_driver_reconnects_total counter\n" +
-      reconnects;
-  out +=
-      "# HELP leakmon_driver_stale_values_total reads that gave a gap because the value was too "
-      "old\n# TYPE leakmon_driver_stale_values_total counter\n" +
-      stale;
-
-  out +=
-      "# HELP leakmon_config_reload_success 1 when the last reload (or start) succeeded\n"
-      "# TYPE leakmon_config_reload_success gauge\n";
-  out += fmt::format("leakmon_config_reload_success {}\n", last_reload_ok_.load() ? 1 : 0);
-  out +=
-      "# HELP leakmon_config_reloads_total reloads applied\n# TYPE leakmon_config_reloads_total "
-      "counter\n";
-  out += fmt::format("leakmon_config_reloads_total {}\n", reloads_.load());
-  out +=
-      "# HELP leakmon_config_reload_failures_total reloads rejected\n# TYPE "
-      "leakmon_config_reload_failures_total counter\n";
-  out += fmt::format("leakmon_config_reload_failures_total {}\n", reload_failures_.load());
-  out +=
-      "# HELP leakmon_config_last_reload_timestamp_seconds unix time of the last reload attempt\n"
-      "# TYPE leakmon_config_last_reload_timestamp_seconds gauge\n";
-  out += fmt::format("leakmon_config_last_reload_timestamp_seconds {}\n", last_reload_unix_.load());
-  return out;
-}
-
-std::string Daemon::status_text() const {
-  std::string out =
-      fmt::format("leakmon {} running {:.0f} s, configuration {}\n", LEAKMON_VERSION,
-                  static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9, config_path_);
-  out += fmt::format("last reload: {}\n", last_reload_ok_.load() ? "ok" : "REJECTED (see log)");
-  for (const auto& g : groups_) {
-    const auto& c = g->loop->counters();
-    out += fmt::format(
-        "group {}: {} cycles, wake-up latency avg {:.1f} us max {:.1f} us, {} overruns, {} missed, "
-        "{} ring drops (high water {}/{}), {}\n",
-        g->config.name, c.cycles.load(), c.wakeup_latency.mean_ns() / 1e3,
-        static_cast<double>(c.wakeup_latency.max_ns()) / 1e3, c.overruns.load(),
-        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(), g->ring->capacity(),
-        g->realtime.fifo ? "SCHED_FIFO" : "normal scheduling");
-  }
-  for (const auto& d : drivers_) {
-    const auto health = d->health();
-    out += fmt::format("driver {}: {}{}{} ({} errors)\n", d->name(), health.state,
-                       health.last_error.empty() ? "" : ": ", health.last_error, health.errors);
-  }
-  for (const auto& a : worker_->status()) {
-    out += fmt::format(
-        "actuator {}: alarm {} {}, index p1 {:.2f} kPa, score {:.3g}, baseline {:.2f} "
-        "kPa{}, detector {}, t {:.2f} s\n",
-        a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score, a.baseline / 1e3,
-        a.learning ? " (learning)" : "", a.detector, a.t);
-  }
-  return out;
 }
 
 }  // namespace leakmon::daemon

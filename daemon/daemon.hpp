@@ -16,11 +16,11 @@
 #include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
 #include "daemon/cpu_latency_request.hpp"
-#include "daemon/event.hpp"
 #include "daemon/http_endpoint.hpp"
 #include "daemon/service_notifier.hpp"
 #include "daemon/worker.hpp"
 #include "io/driver.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
@@ -36,9 +36,9 @@ class Daemon {
   // Throws config::ConfigError / io::DriverError when the configuration cannot start.
   int run(double duration_s = 0);
 
-  // Prometheus text exposition of everything the daemon counts.
+  // Prometheus text exposition of everything the daemon counts (daemon/metrics_text.cpp).
   std::string metrics_text() const;
-  // The human summary `leakmon status` prints.
+  // The human summary `leakmon status` prints (daemon/metrics_text.cpp).
   std::string status_text() const;
 
  private:
@@ -51,15 +51,16 @@ class Daemon {
     RealtimeReport realtime;
     std::atomic<bool> realtime_ready{false};
   };
+  // The driver health last reported in an event (main thread only).
   struct DriverWatch {
-    std::string state = "ok";
-    std::uint64_t errors = 0;
+    io::DeviceStatus status = io::DeviceStatus::ok;
+    std::string detail = "ok";
   };
 
   void start();
   void stop();
-  std::vector<std::unique_ptr<EventSink>> build_sinks(const DaemonConfig& config) const;
-  static std::vector<EventSink*> raw(const std::vector<std::unique_ptr<EventSink>>& sinks);
+  std::vector<std::unique_ptr<io::EventSink>> build_sinks(const DaemonConfig& config) const;
+  static std::vector<io::EventSink*> raw(const std::vector<std::unique_ptr<io::EventSink>>& sinks);
   void reload();
   void housekeeping(std::int64_t now_ns);
   bool making_progress(std::int64_t now_ns);
@@ -70,7 +71,7 @@ class Daemon {
   DaemonConfig config_;
   std::vector<std::unique_ptr<io::Driver>> drivers_;
   std::vector<std::unique_ptr<Group>> groups_;
-  std::vector<std::unique_ptr<EventSink>> sinks_;
+  std::vector<std::unique_ptr<io::EventSink>> sinks_;
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<HttpEndpoint> endpoint_;

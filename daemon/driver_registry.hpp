@@ -1,5 +1,5 @@
-// Which driver `type:` names exist and how each is built from its YAML mapping. Field drivers
-// (Modbus, CAN) register here when their libraries are part of the build.
+// Which driver `type:` names exist and how each is built from its YAML mapping (every driver
+// library is always built and linked).
 #pragma once
 
 #include <memory>
@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "config/yaml_reader.hpp"
+#include "daemon/plugin_registry.hpp"
 #include "io/driver.hpp"
 
 namespace leakmon::daemon {
@@ -15,12 +16,8 @@ namespace leakmon::daemon {
 // Builds a driver from its mapping under `drivers:` (including `name:` and `type:`). Validates
 // every field and fails with ConfigNode::fail (file:line:column) on bad input; does not open
 // devices (that is Driver::start()).
-using DriverFactory = std::unique_ptr<io::Driver> (*)(const config::ConfigNode& node);
-
-struct DriverType {
-  std::string_view type;
-  DriverFactory factory;
-};
+using DriverType = PluginType<io::Driver>;
+using DriverFactory = DriverType::Factory;
 
 std::span<const DriverType> driver_types();
 

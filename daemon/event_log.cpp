@@ -71,20 +71,21 @@ class JsonObject {
   std::string text_ = "{";
 };
 
-bool is_alarm(EventKind kind) {
-  return kind == EventKind::alarm_raised || kind == EventKind::alarm_cleared ||
-         kind == EventKind::alarm_acknowledged;
+bool is_alarm(io::EventKind kind) {
+  return kind == io::EventKind::alarm_raised || kind == io::EventKind::alarm_cleared ||
+         kind == io::EventKind::alarm_acknowledged;
 }
 
 }  // namespace
 
-std::string to_json_line(const Event& event) {
+std::string to_json_line(const io::Event& event) {
   JsonObject json;
   json.number("t", event.t);
   json.string("event", to_string(event.kind));
   json.string("actuator", event.actuator);
   json.string("alarm", event.alarm);
   json.string("channel", event.channel);
+  json.string("fault", event.fault);
   json.number("index", event.index / 1e3);
   json.number("score", event.score);
   json.number("baseline", event.baseline / 1e3);
@@ -104,11 +105,12 @@ std::string to_json_line(const Event& event) {
   return json.finish();
 }
 
-std::string to_log_line(const Event& event) {
+std::string to_log_line(const io::Event& event) {
   std::string line(to_string(event.kind));
   if (!event.actuator.empty()) line += fmt::format(" actuator={}", event.actuator);
   if (!event.alarm.empty()) line += fmt::format(" alarm={}", event.alarm);
   if (!event.channel.empty()) line += fmt::format(" channel={}", event.channel);
+  if (!event.fault.empty()) line += fmt::format(" fault={}", event.fault);
   if (std::isfinite(event.t)) line += fmt::format(" t={:.3f}s", event.t);
   if (std::isfinite(event.index)) line += fmt::format(" index={:.2f}kPa", event.index / 1e3);
   if (std::isfinite(event.baseline)) {
@@ -137,7 +139,7 @@ JsonlEventLog::~JsonlEventLog() {
   if (file_ != nullptr) std::fclose(file_);
 }
 
-void JsonlEventLog::publish(const Event& event) {
+void JsonlEventLog::publish(const io::Event& event) {
   const std::string line = to_json_line(event) + "\n";
   std::fwrite(line.data(), 1, line.size(), file_);
   std::fflush(file_);
@@ -145,16 +147,16 @@ void JsonlEventLog::publish(const Event& event) {
 
 void JsonlEventLog::flush() { std::fflush(file_); }
 
-void LogEventSink::publish(const Event& event) {
+void LogEventSink::publish(const io::Event& event) {
   const auto level =
-      (event.kind == EventKind::alarm_raised || event.kind == EventKind::driver_fault ||
-       event.kind == EventKind::overrun || event.kind == EventKind::config_rejected)
+      (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
+       event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected)
           ? spdlog::level::warn
           : spdlog::level::info;
   spdlog::log(level, "{}", to_log_line(event));
 }
 
-std::unique_ptr<EventSink> make_jsonl_output(const config::ConfigNode& node) {
+std::unique_ptr<io::EventSink> make_jsonl_output(const config::ConfigNode& node) {
   node.expect_keys({"name", "type", "path"});
   const auto path = node.at("path");
   try {

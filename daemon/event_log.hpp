@@ -8,23 +8,23 @@
 #include <vector>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/event.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
 // One JSON object, no trailing newline. Fields that are NaN or empty are left out. `index` is
 // in kPa (as FORMATS.md shows it); leak sizes in l/min/MPa and l/min.
-std::string to_json_line(const Event& event);
+std::string to_json_line(const io::Event& event);
 // The one-line operator message for the log.
-std::string to_log_line(const Event& event);
+std::string to_log_line(const io::Event& event);
 
 // Appends JSON lines to a file, flushed after every event (events are rare and must survive a
 // crash). Opening creates parent directories.
-class JsonlEventLog final : public EventSink {
+class JsonlEventLog final : public io::EventSink {
  public:
   explicit JsonlEventLog(const std::string& path);
   ~JsonlEventLog() override;
-  void publish(const Event& event) override;
+  void publish(const io::Event& event) override;
   void flush() override;
   const std::string& path() const { return path_; }
 
@@ -34,18 +34,18 @@ class JsonlEventLog final : public EventSink {
 };
 
 // Each event as a log line: warnings for alarms and faults, info for the rest.
-class LogEventSink final : public EventSink {
+class LogEventSink final : public io::EventSink {
  public:
-  void publish(const Event& event) override;
+  void publish(const io::Event& event) override;
 };
 
-class CollectingEventSink final : public EventSink {
+class CollectingEventSink final : public io::EventSink {
  public:
-  void publish(const Event& event) override { events.push_back(event); }
-  std::vector<Event> events;
+  void publish(const io::Event& event) override { events.push_back(event); }
+  std::vector<io::Event> events;
 };
 
 // `outputs:` type jsonl: `{name, type: jsonl, path}` — a second event log, e.g. on a share.
-std::unique_ptr<EventSink> make_jsonl_output(const config::ConfigNode& node);
+std::unique_ptr<io::EventSink> make_jsonl_output(const config::ConfigNode& node);
 
 }  // namespace leakmon::daemon

@@ -8,21 +8,18 @@
 #include <string_view>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/event.hpp"
+#include "daemon/plugin_registry.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
 // Builds an output from its mapping under `outputs:` (including `name:` and `type:`); validates
 // with ConfigNode::fail. Must not block on devices here: connect lazily or in a thread.
-using OutputFactory = std::unique_ptr<EventSink> (*)(const config::ConfigNode& node);
-
-struct OutputType {
-  std::string_view type;
-  OutputFactory factory;
-};
+using OutputType = PluginType<io::EventSink>;
+using OutputFactory = OutputType::Factory;
 
 std::span<const OutputType> output_types();
 
-std::unique_ptr<EventSink> make_output(const config::ConfigNode& node);
+std::unique_ptr<io::EventSink> make_output(const config::ConfigNode& node);
 
 }  // namespace leakmon::daemon

@@ -16,16 +16,16 @@ namespace {
 
 constexpr const char* kCaptureDriver = "capture";
 
-std::int64_t period_ns_of(const io::Capture& capture) {
+std::int64_t period_ns_of(const capture::Capture& capture) {
   const double rate = capture.sample_rate_hz();
   if (!(rate > 0.0) || !std::isfinite(rate)) {
-    throw io::CaptureError(fmt::format("{}: cannot tell the sample rate", capture.path));
+    throw capture::CaptureError(fmt::format("{}: cannot tell the sample rate", capture.path));
   }
   return static_cast<std::int64_t>(std::llround(1e9 / rate));
 }
 
 // The configuration with the capture as its only driver.
-DaemonConfig bind_to_capture(const io::Capture& capture, const DaemonConfig& config) {
+DaemonConfig bind_to_capture(const capture::Capture& capture, const DaemonConfig& config) {
   DaemonConfig bound = config;
   bound.drivers = {DriverConfig{kCaptureDriver, "replay", std::nullopt}};
   GroupConfig group;
@@ -36,14 +36,15 @@ DaemonConfig bind_to_capture(const io::Capture& capture, const DaemonConfig& con
   bound.groups = {group};
   bound.recording = {};
   for (auto& actuator : bound.actuators) {
-    for (auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref}) {
+    for (auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
+                      &actuator.ps, &actuator.temp}) {
       if (!ref->present()) continue;
       ref->driver = kCaptureDriver;
       if (ref->channel == "t" || !capture.has(ref->channel)) {
         const std::string message =
             fmt::format("the capture {} has no column '{}'", capture.path, ref->channel);
         if (ref->where) ref->where->fail(message);
-        throw io::CaptureError(message);
+        throw capture::CaptureError(message);
       }
     }
   }
@@ -52,9 +53,9 @@ DaemonConfig bind_to_capture(const io::Capture& capture, const DaemonConfig& con
 
 }  // namespace
 
-DaemonConfig default_replay_config(const io::Capture& capture) {
+DaemonConfig default_replay_config(const capture::Capture& capture) {
   if (!capture.has("p1")) {
-    throw io::CaptureError(
+    throw capture::CaptureError(
         fmt::format("{}: the capture has no p1 column, which the default "
                     "replay configuration indexes",
                     capture.path));
@@ -65,7 +66,8 @@ DaemonConfig default_replay_config(const io::Capture& capture) {
   actuator.name = "actuator";
   for (auto [role, ref] :
        {std::pair{"p1", &actuator.p1}, std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref}}) {
+        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
+        std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
     if (capture.has(role)) *ref = ChannelRef{kCaptureDriver, role, std::nullopt};
   }
   config.actuators.push_back(actuator);
@@ -73,15 +75,15 @@ DaemonConfig default_replay_config(const io::Capture& capture) {
   return bind_to_capture(capture, config);
 }
 
-ReplayResult replay_capture(const io::Capture& capture, const DaemonConfig& config,
+ReplayResult replay_capture(const capture::Capture& capture, const DaemonConfig& config,
                             const ReplayOptions& options) {
   // The driver keeps a shared_ptr; aliasing one that owns nothing avoids copying the capture.
-  return replay_capture(std::shared_ptr<const io::Capture>(std::shared_ptr<void>(), &capture),
+  return replay_capture(std::shared_ptr<const capture::Capture>(std::shared_ptr<void>(), &capture),
                         config, options);
 }
 
-ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture, const DaemonConfig& config,
-                            const ReplayOptions& options) {
+ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
+                            const DaemonConfig& config, const ReplayOptions& options) {
   const DaemonConfig bound = bind_to_capture(*capture, config);
   const GroupConfig& group = bound.groups.front();
 

@@ -8,10 +8,10 @@
 #include <memory>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "daemon/actuator_monitor.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event.hpp"
-#include "io/capture/capture.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
@@ -23,7 +23,7 @@ struct ReplayOptions {
 };
 
 struct ReplayResult {
-  std::vector<Event> events;              // in order
+  std::vector<io::Event> events;          // in order
   std::uint64_t samples_read = 0;         // rows the loop read from the capture
   std::uint64_t samples_processed = 0;    // samples the worker consumed
   std::uint64_t ring_drops = 0;           // 0 unless realtime and the worker fell behind
@@ -31,17 +31,17 @@ struct ReplayResult {
 };
 
 // FORMATS.md built-in defaults: one actuator ("actuator") whose channels are the known columns
-// present (p1 required; p2, u, x, xref when present), index on p1 with db8 level 2, window 400,
-// step 20, symmetric, the default detector; period from the capture's sample rate. Throws
-// io::CaptureError when the capture has no p1.
-DaemonConfig default_replay_config(const io::Capture& capture);
+// present (p1 required; p2, u, x, xref, ps, temp when present), index on p1 with db8 level 2,
+// window 400, step 20, symmetric, the default detector; period from the capture's sample rate.
+// Throws capture::CaptureError when the capture has no p1.
+DaemonConfig default_replay_config(const capture::Capture& capture);
 
 // The capture replaces the configuration's drivers: actuator channels name capture columns
 // (their `driver.` part is ignored), and the single sampling group runs at the capture's rate.
-// Throws config::ConfigError / io::CaptureError on channels the capture does not have.
-ReplayResult replay_capture(const io::Capture& capture, const DaemonConfig& config,
+// Throws config::ConfigError / capture::CaptureError on channels the capture does not have.
+ReplayResult replay_capture(const capture::Capture& capture, const DaemonConfig& config,
                             const ReplayOptions& options = {});
-ReplayResult replay_capture(std::shared_ptr<const io::Capture> capture, const DaemonConfig& config,
-                            const ReplayOptions& options = {});
+ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
+                            const DaemonConfig& config, const ReplayOptions& options = {});
 
 }  // namespace leakmon::daemon

@@ -23,10 +23,16 @@
 //   read_index_.load(acquire) pairs with it, so the producer never overwrites a slot the
 //   consumer is still reading.
 // - Each side reads its own index with relaxed order: only it ever writes it.
+//
+// As in rigtorp's SPSCQueue, a result that says whether anything happened is [[nodiscard]]
+// (a dropped push must be counted), misuse (pop() on an empty ring) is asserted in debug
+// builds, and the cache-line layout is checked at compile time.
 #pragma once
 
 #include <atomic>
+#include <cassert>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -43,16 +49,20 @@ class SpscRing {
 
  public:
   explicit SpscRing(std::size_t capacity)
-      : slots_count_(capacity + 1), slots_(std::make_unique<T[]>(capacity + 1)) {
-    if (capacity < 1) throw std::invalid_argument("SpscRing capacity must be at least 1");
+      : slots_count_(checked_slots(capacity)), slots_(std::make_unique<T[]>(slots_count_)) {
+    // The four indices each start their own cache line, after the line of slots_count_ and
+    // slots_, so the object spans at least five lines and is itself line-aligned.
+    static_assert(alignof(SpscRing) == kCacheLine);
+    static_assert(sizeof(SpscRing) >= 5 * kCacheLine);
+    static_assert(std::atomic<std::size_t>::is_always_lock_free);
   }
   SpscRing(const SpscRing&) = delete;
   SpscRing& operator=(const SpscRing&) = delete;
 
-  std::size_t capacity() const noexcept { return slots_count_ - 1; }
+  [[nodiscard]] std::size_t capacity() const noexcept { return slots_count_ - 1; }
 
   // Producer only. False when full (nothing written).
-  bool try_push(const T& value) noexcept {
+  [[nodiscard]] bool try_push(const T& value) noexcept {
     const std::size_t write = write_index_.load(std::memory_order_relaxed);
     std::size_t next = write + 1;
     if (next == slots_count_) next = 0;
@@ -66,7 +76,7 @@ class SpscRing {
   }
 
   // Consumer only. The oldest element, or nullptr when empty; valid until pop().
-  T* front() noexcept {
+  [[nodiscard]] T* front() noexcept {
     const std::size_t read = read_index_.load(std::memory_order_relaxed);
     if (read == cached_write_index_) {
       cached_write_index_ = write_index_.load(std::memory_order_acquire);
@@ -78,13 +88,15 @@ class SpscRing {
   // Consumer only, after front() returned an element.
   void pop() noexcept {
     const std::size_t read = read_index_.load(std::memory_order_relaxed);
+    assert(read != write_index_.load(std::memory_order_acquire) &&
+           "SpscRing::pop() only after front() returned an element");
     std::size_t next = read + 1;
     if (next == slots_count_) next = 0;
     read_index_.store(next, std::memory_order_release);
   }
 
   // Consumer only: copy out and pop the oldest element. False when empty.
-  bool try_pop(T& out) noexcept {
+  [[nodiscard]] bool try_pop(T& out) noexcept {
     T* element = front();
     if (element == nullptr) return false;
     out = *element;
@@ -93,16 +105,27 @@ class SpscRing {
   }
 
   // Either side, approximate (for metrics): elements currently queued.
-  std::size_t size() const noexcept {
+  [[nodiscard]] std::size_t size() const noexcept {
     const std::ptrdiff_t diff =
         static_cast<std::ptrdiff_t>(write_index_.load(std::memory_order_acquire)) -
         static_cast<std::ptrdiff_t>(read_index_.load(std::memory_order_acquire));
-    return static_cast<std::size_t>(diff < 0 ? diff + static_cast<std::ptrdiff_t>(slots_count_)
-                                             : diff);
+    const auto queued = static_cast<std::size_t>(
+        diff < 0 ? diff + static_cast<std::ptrdiff_t>(slots_count_) : diff);
+    assert(queued <= capacity());
+    return queued;
   }
-  bool empty() const noexcept { return size() == 0; }
+  [[nodiscard]] bool empty() const noexcept { return size() == 0; }
 
  private:
+  // One slot more than the capacity; the index arithmetic (and the slot array) must fit.
+  static std::size_t checked_slots(std::size_t capacity) {
+    if (capacity < 1) throw std::invalid_argument("SpscRing capacity must be at least 1");
+    if (capacity > std::numeric_limits<std::ptrdiff_t>::max() / sizeof(T) - 1) {
+      throw std::invalid_argument("SpscRing capacity too large");
+    }
+    return capacity + 1;
+  }
+
   const std::size_t slots_count_;
   const std::unique_ptr<T[]> slots_;
 

@@ -18,12 +18,12 @@ ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<Channe
     }
     return -1;
   };
-  return ChannelLayout{find(actuator.p1), find(actuator.p2), find(actuator.u), find(actuator.x),
-                       find(actuator.xref)};
+  return ChannelLayout{find(actuator.p1),   find(actuator.p2), find(actuator.u),   find(actuator.x),
+                       find(actuator.xref), find(actuator.ps), find(actuator.temp)};
 }
 
 Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
-               std::vector<EventSink*> sinks)
+               std::vector<io::EventSink*> sinks)
     : sinks_(std::move(sinks)) {
   for (auto& input : groups) {
     GroupState group;
@@ -59,6 +59,7 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
         if (old && old->name() == actuator.name && old->same_pipeline(actuator, layout)) {
           kept = std::move(old);
           kept->set_alarm_settings(actuator.alarm);
+          kept->set_transducers(actuator);
           break;
         }
       }
@@ -86,7 +87,7 @@ std::size_t Worker::drain(std::int64_t now_ns) {
 }
 
 void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_ns) {
-  const EventPublisher publish = [this](const Event& event) { publish_locked(event); };
+  const EventPublisher publish = [this](const io::Event& event) { publish_locked(event); };
   // Ticks that never arrived (missed cycles, ring drops) are gaps: they must invalidate the
   // windows that span them, not silently splice the signal together.
   if (group.started && sample.tick > group.next_tick) {
@@ -112,9 +113,9 @@ void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_n
   (void)now_ns;
 }
 
-void Worker::publish_locked(const Event& event) {
+void Worker::publish_locked(const io::Event& event) {
   ++events_;
-  Event stamped = event;
+  io::Event stamped = event;
   if (std::isnan(stamped.unix_time)) {
     stamped.unix_time =
         std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -122,14 +123,14 @@ void Worker::publish_locked(const Event& event) {
   for (auto* sink : sinks_) sink->publish(stamped);
 }
 
-void Worker::publish(const Event& event) {
+void Worker::publish(const io::Event& event) {
   std::lock_guard lock(mutex_);
   publish_locked(event);
 }
 
 std::size_t Worker::acknowledge(const std::string& actuator) {
   std::lock_guard lock(mutex_);
-  const EventPublisher publish = [this](const Event& event) { publish_locked(event); };
+  const EventPublisher publish = [this](const io::Event& event) { publish_locked(event); };
   std::size_t matched = 0;
   for (auto& group : groups_) {
     for (auto& monitor : group.monitors) {
@@ -141,7 +142,7 @@ std::size_t Worker::acknowledge(const std::string& actuator) {
   return matched;
 }
 
-void Worker::apply(const DaemonConfig& config, std::vector<EventSink*> sinks) {
+void Worker::apply(const DaemonConfig& config, std::vector<io::EventSink*> sinks) {
   std::lock_guard lock(mutex_);
   for (auto& group : groups_) {
     auto previous = std::move(group.monitors);

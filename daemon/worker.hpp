@@ -13,10 +13,10 @@
 #include "daemon/actuator_monitor.hpp"
 #include "daemon/capture_recorder.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event.hpp"
 #include "daemon/latency_histogram.hpp"
 #include "daemon/sample.hpp"
 #include "daemon/spsc_ring.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::daemon {
 
@@ -31,7 +31,8 @@ class Worker {
  public:
   // Builds a monitor per actuator (throws config::ConfigError / std::invalid_argument on a
   // detector that cannot be built) and a recorder per group when recording is configured.
-  Worker(const DaemonConfig& config, std::vector<GroupInput> groups, std::vector<EventSink*> sinks);
+  Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
+         std::vector<io::EventSink*> sinks);
   ~Worker();
 
   // Pops and processes everything queued now; returns the samples processed. `now_ns` is the
@@ -39,12 +40,12 @@ class Worker {
   std::size_t drain(std::int64_t now_ns);
 
   // Daemon-wide events (driver faults, overruns, reloads) go through the same ordered path.
-  void publish(const Event& event);
+  void publish(const io::Event& event);
   // Acknowledge the alarms of `actuator` (empty: all). Returns how many actuators were known.
   std::size_t acknowledge(const std::string& actuator);
   // Reload: same groups, new actuators/alarms/sinks. Monitors whose signals, features and
   // detector are unchanged keep their learned state and alarm state.
-  void apply(const DaemonConfig& config, std::vector<EventSink*> sinks);
+  void apply(const DaemonConfig& config, std::vector<io::EventSink*> sinks);
   void flush();
 
   std::vector<ActuatorStatus> status() const;
@@ -64,11 +65,11 @@ class Worker {
   void build_monitors(const DaemonConfig& config, GroupState& group,
                       std::vector<std::unique_ptr<ActuatorMonitor>>* previous);
   void process(GroupState& group, const Sample& sample, std::int64_t now_ns);
-  void publish_locked(const Event& event);
+  void publish_locked(const io::Event& event);
 
   mutable std::mutex mutex_;
   std::vector<GroupState> groups_;
-  std::vector<EventSink*> sinks_;
+  std::vector<io::EventSink*> sinks_;
   std::uint64_t samples_ = 0;
   std::uint64_t events_ = 0;
   LatencyHistogram decision_latency_;

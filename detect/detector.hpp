@@ -24,6 +24,8 @@ struct Observation {
   double x = kMissing;   // position [m]
   double p1 = kMissing;  // chamber pressures [Pa]
   double p2 = kMissing;
+  double ps = kMissing;    // supply pressure [Pa], where the rig has that transducer
+  double temp = kMissing;  // oil temperature [degC], where the rig has that transducer
   // Standard deviation of the position reference or position over the window, when known: the
   // excitation that produced the index.
   double x_activity = kMissing;
@@ -41,6 +43,9 @@ struct Decision {
   // the detector cannot size the leak.
   double leak_coefficient = kMissing;
   double leak_coefficient_ci = kMissing;
+  // nu(40 degC) / nu(T) at the oil temperature of this hop when the detector knows it (the
+  // leak coefficient is then stated at 40 degC and flows r C_L (p1 - p2) now); NaN otherwise.
+  double viscosity_ratio = kMissing;
 };
 
 class Detector {

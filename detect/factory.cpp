@@ -13,6 +13,7 @@
 #include "detect/fused_detector.hpp"
 #include "detect/index_cusum_detector.hpp"
 #include "detect/paper_baseline_detector.hpp"
+#include "sim/oil.hpp"
 
 namespace leakmon::detect {
 
@@ -54,7 +55,14 @@ constexpr std::string_view kFlowKeysData[] = {"supply_pressure",
                                               "design_leak",
                                               "false_alarms_per_hour",
                                               "block_seconds",
-                                              "sizing_seconds"};
+                                              "sizing_seconds",
+                                              "min_leak",
+                                              "drift_guard_seconds",
+                                              "drift_window_seconds",
+                                              "estimate_supply",
+                                              "oil_grade",
+                                              "oil_viscosity_40",
+                                              "oil_viscosity_100"};
 constexpr std::string_view kPaperKeysData[] = {"baseline_quantile", "window_seconds",
                                                "raise_fraction", "clear_fraction", "channel"};
 constexpr KeyList kLearningKeys = kLearningKeysData, kIndexKeys = kIndexKeysData,
@@ -88,6 +96,31 @@ IndexCusumOptions index_options(const config::ConfigNode* options, const Availab
   return o;
 }
 
+// The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
+// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; VG 46 when
+// neither is given.
+sim::Oil oil_of(const config::ConfigNode& options) {
+  const auto grade = options.find("oil_grade");
+  const auto nu40 = options.find("oil_viscosity_40");
+  const auto nu100 = options.find("oil_viscosity_100");
+  if (grade && (nu40 || nu100)) grade->fail("give either oil_grade or the two viscosities");
+  if (grade) {
+    const auto oil = sim::Oil::iso_vg(static_cast<int>(grade->as_int()));
+    if (!oil) grade->fail("oil_grade must be 32, 46 or 68 (or give oil_viscosity_40/100)");
+    return *oil;
+  }
+  if (nu40 || nu100) {
+    if (!nu40 || !nu100) {
+      (nu40 ? *nu40 : *nu100).fail("give both oil_viscosity_40 and oil_viscosity_100");
+    }
+    const double a = nu40->check_range(nu40->as_double(), 1.0, 10000.0);
+    const double b = nu100->check_range(nu100->as_double(), 0.5, 1000.0);
+    if (!(a > b)) nu100->fail("oil_viscosity_100 must be below oil_viscosity_40");
+    return sim::Oil(a, b);
+  }
+  return sim::Oil::standard();
+}
+
 FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {
   FlowBalanceOptions o;
   read_learning(options, o.learning);
@@ -104,6 +137,13 @@ FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_
   read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
   read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
   read(options, "sizing_seconds", o.sizing_seconds, 1.0, kMaxSeconds);
+  read(options, "min_leak", o.min_leak, 0.0, 1e-8);
+  read(options, "drift_guard_seconds", o.drift_guard_seconds, 0.0, 3600.0);
+  read(options, "drift_window_seconds", o.drift_window_seconds, 1.0, 3600.0);
+  if (options != nullptr) {
+    o.estimate_supply = options->get_bool("estimate_supply", o.estimate_supply);
+    o.oil = oil_of(*options);
+  }
   o.false_alarms_per_hour *= false_alarm_share;
   return o;
 }

@@ -11,6 +11,18 @@ namespace {
 
 double sign_of(double value) { return value > 0.0 ? 1.0 : (value < 0.0 ? -1.0 : 0.0); }
 
+// A change of the supply (or of its rest-sum estimate) by more than this share of the
+// configured supply is a transient: blocks are not judged until it has settled for
+// kSupplySettleSeconds (the chambers follow the supply at rest within about a second).
+constexpr double kSupplyStep = 0.02;
+constexpr double kSupplySettleSeconds = 3.0;
+// Memory of the rest-sum supply estimate between steps.
+constexpr double kSupplySeconds = 2.0;
+// The drift trend needs this many blocks in its reference window to fit a slope; with fewer
+// (but at least kTrendLevelBlocks) it uses their level.
+constexpr std::size_t kTrendSlopeBlocks = 20;
+constexpr std::size_t kTrendLevelBlocks = 3;
+
 double upper_sigma_bound(double sigma, std::size_t blocks) {
   if (blocks < 2) return sigma;
   return sigma * (1.0 + 1.645 / std::sqrt(2.0 * static_cast<double>(blocks - 1)));
@@ -31,10 +43,14 @@ FlowBalanceDetector::FlowBalanceDetector(const FlowBalanceOptions& options, doub
           1)),
       piston_area_(options.rig.A()),
       design_slope_(options.design_leak * std::sqrt(options.rig.ps) / options.rig.Kv),
+      floor_slope_(options.min_leak * std::sqrt(options.rig.ps) / options.rig.Kv),
       sizing_decay_(std::exp(-options.block_seconds / options.sizing_seconds)),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)) {
   learned_.reserve(learn_hops_);
   scratch_.reserve(learn_hops_);
+  const double trend_seconds =
+      options.drift_guard_seconds + options.drift_window_seconds + options.block_seconds;
+  trend_.resize(static_cast<std::size_t>(std::ceil(trend_seconds / options.block_seconds)) + 2);
 }
 
 void FlowBalanceDetector::reset() {
@@ -51,6 +67,68 @@ void FlowBalanceDetector::reset() {
   block_residual_sum_ = block_leak_term_sum_ = 0.0;
   weighted_ = since_change_ = change_block_ = SlopeSums{};
   cusum_.reset();
+  supply_estimate_ = supply_settled_since_ = kMissing;
+  temperature_seen_ = false;
+  trend_next_ = trend_count_ = 0;
+}
+
+void FlowBalanceDetector::remember_block(double t, double residual, double leak_term) {
+  trend_[trend_next_] = {t, residual, leak_term};
+  trend_next_ = (trend_next_ + 1) % trend_.size();
+  trend_count_ = std::min(trend_count_ + 1, trend_.size());
+}
+
+// Weighted least squares of residual = leak_term (a + b (t_k - t)) over the reference window:
+// a is the healthy slope now. The extrapolation is bounded by the leak floor, so a trend fitted
+// to a few noisy blocks can never carry the reference further than a leak of interest.
+double FlowBalanceDetector::drift_slope(double t) const {
+  const double newest = t - options_.drift_guard_seconds;
+  const double oldest = newest - options_.drift_window_seconds;
+  double ll = 0.0, llt = 0.0, lltt = 0.0, rl = 0.0, rlt = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < trend_count_; ++i) {
+    const TrendBlock& b = trend_[i];
+    if (b.t < oldest || b.t > newest) continue;
+    const double tau = b.t - t, l2 = b.leak_term * b.leak_term;
+    ll += l2;
+    llt += l2 * tau;
+    lltt += l2 * tau * tau;
+    rl += b.residual * b.leak_term;
+    rlt += b.residual * b.leak_term * tau;
+    ++n;
+  }
+  if (n < kTrendLevelBlocks || !(ll > 0.0)) return 0.0;
+  const double level_now = rl / ll;  // the window's level, if no slope can be fitted
+  if (n < kTrendSlopeBlocks) return level_now;
+  const double det = ll * lltt - llt * llt;
+  if (!(det > 0.0)) return level_now;
+  const double extrapolated = (rl * lltt - rlt * llt) / det;
+  const double level = rl / ll;  // at the window's weighted centre
+  return level + std::clamp(extrapolated - level, -floor_slope_, floor_slope_);
+}
+
+double FlowBalanceDetector::supply_for(const Observation& o, double speed) {
+  const double configured = options_.rig.ps;
+  double reading = kMissing;
+  if (!std::isnan(o.ps)) {
+    reading = o.ps;
+  } else if (options_.estimate_supply && !std::isnan(o.p1) && !std::isnan(o.p2) &&
+             std::abs(speed) < options_.rest_speed &&
+             std::abs(pending_.speed) < options_.rest_speed) {
+    // At rest the valve's lands balance: p1 + p2 = ps + pt (MODEL.md).
+    reading = o.p1 + o.p2 - options_.rig.pt;
+  }
+  if (!std::isnan(reading)) {
+    if (std::isnan(supply_estimate_) ||
+        std::abs(reading - supply_estimate_) > kSupplyStep * configured) {
+      if (!std::isnan(supply_estimate_)) supply_settled_since_ = o.t;
+      supply_estimate_ = reading;
+    } else {
+      const double memory = std::isnan(o.ps) ? std::exp(-hop_seconds_ / kSupplySeconds) : 0.0;
+      supply_estimate_ = memory * supply_estimate_ + (1.0 - memory) * reading;
+    }
+  }
+  return std::isnan(supply_estimate_) ? configured : supply_estimate_;
 }
 
 // The healthy command at rest. The valve's null leakage needs an opening proportional to the
@@ -132,14 +210,16 @@ void FlowBalanceDetector::finish_learning() {
   bool have_previous = false;
   for (std::size_t i = 0; i < learned_.size();) {
     std::size_t j = i, kept = 0;
-    double residual_sum = 0.0;
+    double residual_sum = 0.0, leak_term_sum = 0.0;
     for (; j < learned_.size() && learned_[j].block == learned_[i].block; ++j) {
       if (!on_flow_branch(learned_[j].hop)) continue;
       residual_sum += learned_[j].hop.opening - expected_opening(learned_[j].hop);
+      leak_term_sum += learned_[j].hop.leak_term;
       ++kept;
     }
     if (kept >= min_rest_hops_) {
       const double mean = residual_sum / static_cast<double>(kept);
+      remember_block(learned_[j - 1].hop.t, mean, leak_term_sum / static_cast<double>(kept));
       sum_sq += mean * mean;
       if (have_previous && learned_[i].block == previous_block + 1) sum_lag += mean * previous_mean;
       have_previous = true;
@@ -159,19 +239,26 @@ void FlowBalanceDetector::finish_learning() {
   learned_model_ = true;
 }
 
-void FlowBalanceDetector::judge_block(double mean_residual, double mean_leak_term) {
+void FlowBalanceDetector::judge_block(double t, double mean_residual, double mean_leak_term) {
   // Log-likelihood ratio of "residual = design_slope * leak term" against "residual = 0", in units
   // of the block spread. The designed shift is capped at kMaxShift spreads and the residual
   // winsorised at kMaxZ: one odd block (a disturbance the balance does not model) can then
   // add at most kMaxShift * (kMaxZ - kMaxShift / 2), well below the threshold.
+  // The null hypothesis is a leak of min_leak (the floor), so the statistic drifts down below
+  // it: z is the block's residual beyond the floor's.
   constexpr double kMaxShift = 3.0, kMaxZ = 4.0;
+  const double reference = follows_drift() ? drift_slope(t) : 0.0;
+  const double excess = mean_residual - reference * mean_leak_term;
   const double shift =
       std::clamp(design_slope_ * mean_leak_term / block_sigma_, -kMaxShift, kMaxShift);
-  const double z = std::clamp(mean_residual / block_sigma_, -kMaxZ, kMaxZ);
+  const double floor = floor_slope_ * mean_leak_term / block_sigma_;
+  const double z = std::clamp(excess / block_sigma_ - floor, -kMaxZ, kMaxZ);
   const bool was_quiet = cusum_.value() <= 0.0;
   cusum_.add(shift * (z - shift / 2.0));
+  // Blocks under suspicion stay out of the drift reference, so a leak is never learned as drift.
+  if (cusum_.normalised() < 0.5) remember_block(t, mean_residual, mean_leak_term);
 
-  const double rl = mean_residual * mean_leak_term, ll = mean_leak_term * mean_leak_term;
+  const double rl = excess * mean_leak_term, ll = mean_leak_term * mean_leak_term;
   weighted_.rl = sizing_decay_ * weighted_.rl + rl;
   weighted_.ll = sizing_decay_ * weighted_.ll + ll;
   weighted_.ll_sq = sizing_decay_ * sizing_decay_ * weighted_.ll_sq + ll;
@@ -185,26 +272,39 @@ void FlowBalanceDetector::judge_block(double mean_residual, double mean_leak_ter
 }
 
 Decision FlowBalanceDetector::update(const Observation& o) {
-  const double ps = options_.rig.ps;
+  // Load, root factor and leak term are scaled by the configured supply (a constant), so the
+  // learned coefficients keep their meaning when the actual supply moves; the orifice law
+  // itself is evaluated at the actual supply.
+  const double ps_ref = options_.rig.ps;
   Hop hop;
+  hop.t = o.t;
   hop.speed = (o.x - previous_x_) / hop_seconds_;
   previous_x_ = o.x;
+  hop.supply = supply_for(o, hop.speed);
+  if (!std::isnan(o.temp)) temperature_seen_ = true;
+  const bool temperature_ok = !temperature_seen_ || !std::isnan(o.temp);
+  const bool supply_settled =
+      std::isnan(supply_settled_since_) || o.t - supply_settled_since_ >= kSupplySettleSeconds;
   hop.usable = !std::isnan(o.u) && !std::isnan(o.p1) && !std::isnan(o.p2) &&
-               !std::isnan(hop.speed) && std::abs(o.u) < 0.5 * options_.rig.u_max;
+               !std::isnan(hop.speed) && temperature_ok && supply_settled &&
+               std::abs(o.u) < 0.5 * options_.rig.u_max;
   if (hop.usable) {
     // Judged in the command's own units (fractions of full spool travel), on the side the
     // load makes the valve open to at rest (it feeds the leaks out of the loaded chamber): so
     // a command offset or a dead band is a constant whatever the command's sign, where the
     // orifice law read through the measured command would switch sides at the wrong place.
     // Load in units of ps, root factor in units of sqrt(ps).
-    hop.load = (o.p1 - o.p2) / ps;
-    const double full_open = std::copysign(options_.rig.u_max, hop.load);
-    const double root =
-        std::abs(load_flow_per_kv(options_.rig, full_open, o.p1, o.p2)) / std::sqrt(ps);
+    sim::Parameters rig = options_.rig;
+    rig.ps = hop.supply;
+    hop.load = (o.p1 - o.p2) / ps_ref;
+    const double full_open = std::copysign(rig.u_max, hop.load);
+    const double root = std::abs(load_flow_per_kv(rig, full_open, o.p1, o.p2)) / std::sqrt(ps_ref);
     hop.usable = hop.usable && root > kMinRoot;
-    hop.opening = o.u / options_.rig.u_max -
-                  piston_area_ * hop.speed / (options_.rig.Kv * std::sqrt(ps) * root);
-    hop.leak_term = hop.load / root;
+    hop.opening = o.u / rig.u_max - piston_area_ * hop.speed / (rig.Kv * std::sqrt(ps_ref) * root);
+    // Laminar leaks follow the viscosity: scaled to 40 degC, the learned null leakage and any
+    // new leak are constants of the rig.
+    hop.viscosity_ratio = std::isnan(o.temp) ? kMissing : options_.oil.ratio(o.temp);
+    hop.leak_term = hop.load / root * (std::isnan(o.temp) ? 1.0 : hop.viscosity_ratio);
     hop.root = root;
   }
   auto still = [&](const Hop& h) { return h.usable && std::abs(h.speed) < options_.rest_speed; };
@@ -217,7 +317,7 @@ Decision FlowBalanceDetector::update(const Observation& o) {
 }
 
 void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
-  const double ps = options_.rig.ps;
+  const double ps = options_.rig.ps;  // the scale of the slope (see update())
   Decision decision;
   ++hops_seen_;
   if (hops_seen_ <= settle_hops_) {
@@ -244,12 +344,13 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
   if (++block_hop_ >= block_hops_) {
     if (block_rest_hops_ >= min_rest_hops_) {
       const double n = static_cast<double>(block_rest_hops_);
-      judge_block(block_residual_sum_ / n, block_leak_term_sum_ / n);
+      judge_block(hop.t, block_residual_sum_ / n, block_leak_term_sum_ / n);
     }
     block_hop_ = block_rest_hops_ = 0;
     block_residual_sum_ = block_leak_term_sum_ = 0.0;
   }
   decision.score = cusum_.normalised();
+  decision.viscosity_ratio = hop.viscosity_ratio;
   const SlopeSums& sums = cusum_.value() <= 0.0    ? weighted_
                           : since_change_.ll > 0.0 ? since_change_
                           : change_block_.ll > 0.0 ? change_block_

@@ -11,6 +11,17 @@
 // +-`valve_coefficient_uncertainty`, which the reported confidence interval includes. The
 // controller's integral action or position error does not matter: whatever hides the leak from
 // x, the valve still has to be opened to feed it.
+//
+// A real rig drifts (MODEL.md "Drifting operating conditions"). Every laminar leak path, the
+// valve's null leakage included, follows the oil's viscosity: at rest a warmer oil looks exactly
+// like a cross-piston leak. With a `temp` observation the leak term is scaled to 40 degC by the
+// viscosity ratio, so the learned null leakage and the reported leak size are both stated at the
+// reference temperature. Without one, the healthy slope is followed as a trend fitted to the
+// blocks of a reference window that ends `drift_guard_seconds` ago: a leak opens within a
+// second or so and is judged long before it reaches that window, while the oil's drift (at most
+// a few 1e-15 m^3/(s Pa) per second) is tracked. The supply pressure is read from a `ps`
+// observation or, without one, from the chamber pressures at rest (p1 + p2 = ps + pt there).
+// A leak smaller than `min_leak` (at 40 degC) is never an alarm, however significant.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +33,7 @@
 #include "detect/detector.hpp"
 #include "detect/learning_schedule.hpp"
 #include "detect/valve_flow.hpp"
+#include "sim/oil.hpp"
 #include "sim/parameters.hpp"
 
 namespace leakmon::detect {
@@ -41,6 +53,17 @@ struct FlowBalanceOptions {
   double block_seconds = 0.8;
   double min_rest_fraction = 0.25;  // a block needs this share of hops at rest
   double sizing_seconds = 60.0;     // memory of the C_L estimate when there is no change
+  // Oil grade: the viscosity ratio that scales laminar leaks with a `temp` observation.
+  sim::Oil oil = sim::Oil::standard();
+  // Minimum leak of interest at 40 degC [m^3/(s Pa)]: the CUSUM drifts down below it, so a
+  // significant but practically irrelevant change (or what is left of the oil's drift) does
+  // not raise. 5e-13 is 0.03 l/min/MPa, a seventh of the paper's smallest leak.
+  double min_leak = 5e-13;
+  // Drift following without a `temp` observation (see the class comment).
+  double drift_guard_seconds = 30.0;
+  double drift_window_seconds = 120.0;
+  // Supply from the chamber pressures at rest when there is no `ps` observation.
+  bool estimate_supply = true;
 };
 
 class FlowBalanceDetector final : public Detector {
@@ -55,11 +78,15 @@ class FlowBalanceDetector final : public Detector {
 
  private:
   struct Hop {
+    double t = kMissing;
     double opening = kMissing;    // command minus what moves the piston [of full travel]
     double load = kMissing;       // load pressure [of ps]
     double root = kMissing;       // orifice root factor of the side the valve opens to at rest
     double leak_term = kMissing;  // load / root: the opening a leak needs per unit C sqrt(ps)/Kv
+                                  // (times the viscosity ratio with a temperature)
     double speed = kMissing;
+    double supply = kMissing;           // supply pressure used for this hop [Pa]
+    double viscosity_ratio = kMissing;  // nu(40) / nu(T) with a temperature
     bool usable = false;  // all signals present and the command within the valve's range
   };
   struct RestHop {
@@ -83,13 +110,22 @@ class FlowBalanceDetector final : public Detector {
   static constexpr double kMinRoot = 1e-3;  // a chamber at supply or tank: no flow to judge
   void accept(const Hop& hop, bool at_rest);
   void finish_learning();
-  void judge_block(double mean_residual, double mean_leak_term);
+  void judge_block(double t, double mean_residual, double mean_leak_term);
+  double supply_for(const Observation& o, double speed);
+  // Drift following: the healthy slope extrapolated to t from the reference window's blocks.
+  struct TrendBlock {
+    double t, residual, leak_term;
+  };
+  void remember_block(double t, double residual, double leak_term);
+  double drift_slope(double t) const;
+  bool follows_drift() const { return !temperature_seen_; }
 
   FlowBalanceOptions options_;
   double hop_seconds_;
   std::size_t settle_hops_, learn_hops_, block_hops_, min_rest_hops_;
   double piston_area_;   // A() of the rig table, computed once
   double design_slope_;  // design_leak in the normalised units of the regression
+  double floor_slope_;   // min_leak in the same units
   double sizing_decay_;  // per block
   std::size_t observations_ = 0;
   std::size_t hops_seen_ = 0;  // accepted hops (one behind the observations)
@@ -116,6 +152,13 @@ class FlowBalanceDetector final : public Detector {
   SlopeSums weighted_, since_change_, change_block_;
   Cusum cusum_;
   Decision last_;
+  // Supply tracking (no `ps` observation): rest-sum estimate and its settling state.
+  double supply_estimate_ = kMissing;
+  double supply_settled_since_ = kMissing;  // t at which the last supply transient ended
+  bool temperature_seen_ = false;
+  // Blocks for the drift trend, oldest first in a ring (capacity reserved at construction).
+  std::vector<TrendBlock> trend_;
+  std::size_t trend_next_ = 0, trend_count_ = 0;
 };
 
 }  // namespace leakmon::detect

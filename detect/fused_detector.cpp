@@ -31,6 +31,7 @@ Decision FusedDetector::update(const Observation& observation) {
     if (std::isnan(fused.leak_coefficient) && !std::isnan(d.leak_coefficient)) {
       fused.leak_coefficient = d.leak_coefficient;
       fused.leak_coefficient_ci = d.leak_coefficient_ci;
+      fused.viscosity_ratio = d.viscosity_ratio;
     }
   }
   return fused;

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/device_status.hpp"
+
 namespace leakmon::io {
 
 class DriverError : public std::runtime_error {
@@ -29,11 +31,15 @@ enum class ReadStatus {
 
 // Counters and state that non-real-time threads read for metrics and events. Thread-safe.
 struct DriverHealth {
-  std::string state = "ok";       // e.g. "ok", "connecting", "disconnected", "bus-off"
-  std::string last_error;         // the newest error message, empty when none
-  std::uint64_t errors = 0;       // communication errors since start
+  // The NAMUR NE 107 category operators and the daemon act on (driver_fault / driver_recovered
+  // events, leakmon_driver_up), and the driver's own word for its state beside it ("ok",
+  // "connecting", "disconnected", "bus-off", ...) for people reading logs and status.
+  DeviceStatus status = DeviceStatus::ok;
+  std::string detail = "ok";
+  std::string last_error;    // the newest error message, empty when none
+  std::uint64_t errors = 0;  // communication errors since start
   std::uint64_t reconnects = 0;
-  std::uint64_t stale_values = 0; // reads that returned a gap because the value was too old
+  std::uint64_t stale_values = 0;  // reads that returned a gap because the value was too old
 };
 
 class Driver {
@@ -54,8 +60,9 @@ class Driver {
   virtual void stop() = 0;
 
   // Real-time: one value per channel for this tick; NaN marks a gap. Must not allocate, lock,
-  // block on I/O or log.
-  virtual ReadStatus read(const Tick& tick, std::span<double> values) = 0;
+  // block on I/O or log, and must not throw: the acquisition loop cannot recover from an
+  // exception, so a driver turns its failures into gaps and reports them through health().
+  virtual ReadStatus read(const Tick& tick, std::span<double> values) noexcept = 0;
 
   // The source's own time for the last read, when it has one (replay: the capture's t).
   virtual std::optional<double> source_time() const { return std::nullopt; }

@@ -71,8 +71,8 @@ double ActuatorModel::spool_input(double u) const {
 
 ActuatorState ActuatorModel::derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
                                         double spool_in, double t) const {
-  const sim::ActuatorRates r =
-      sim::actuator_rates(c, t, spool_in, 0.0, parameters_.effects.C_L, s.xs, s.x, s.v, s.p1, s.p2);
+  const sim::ActuatorRates r = sim::actuator_rates(c, t, spool_in, 0.0, parameters_.effects.C_L,
+                                                   c.C_E, s.xs, s.x, s.v, s.p1, s.p2);
   ActuatorState d{r.xs, r.x, r.v, r.p1, r.p2, 0.0};
   if (lagging_) {
     d.s = sim::transducer_lag_rate(c.lag_p1 ? r.p1_clamped : r.p2_clamped, s.s, c.lag_tau_s);

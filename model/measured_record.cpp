@@ -90,7 +90,7 @@ void require_columns(const std::vector<std::string>& columns, const std::string&
   }
 }
 
-std::string controller_from(const io::Metadata& metadata) {
+std::string controller_from(const capture::Metadata& metadata) {
   for (const auto& [key, value] : metadata) {
     if (key != "controller") continue;
     if (value.find("fault") != std::string::npos) return "fault_tolerant";
@@ -102,7 +102,7 @@ std::string controller_from(const io::Metadata& metadata) {
 }  // namespace
 
 MeasuredRecord read_measured_record(const std::string& path, const RecordRequirements& req) {
-  io::CaptureReader reader(path);
+  capture::CaptureReader reader(path);
   require_columns(reader.columns(), path);
   const auto col = [&](std::string_view name) { return *reader.column_index(name); };
   const auto xref = reader.column_index("xref");
@@ -125,7 +125,7 @@ MeasuredRecord read_measured_record(const std::string& path, const RecordRequire
   return vet(std::move(rec), origin, req);
 }
 
-MeasuredRecord measured_record(const io::Capture& capture, const RecordRequirements& req) {
+MeasuredRecord measured_record(const capture::Capture& capture, const RecordRequirements& req) {
   require_columns(capture.columns, capture.path);
   MeasuredRecord rec;
   rec.source = capture.path;

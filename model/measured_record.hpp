@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 
 namespace leakmon::model {
 
@@ -37,10 +37,10 @@ struct RecordRequirements {
   double rate_tolerance = 0.01;    // relative deviation of any t step from the period
 };
 
-// Reads and vets a capture file. Throws io::CaptureError for malformed CSV (file:line:column)
+// Reads and vets a capture file. Throws capture::CaptureError for malformed CSV (file:line:column)
 // and ModelCheckError for data that cannot be diagnosed.
 MeasuredRecord read_measured_record(const std::string& path, const RecordRequirements& req = {});
 // The same checks on a capture already in memory (line numbers are then row numbers).
-MeasuredRecord measured_record(const io::Capture& capture, const RecordRequirements& req = {});
+MeasuredRecord measured_record(const capture::Capture& capture, const RecordRequirements& req = {});
 
 }  // namespace leakmon::model

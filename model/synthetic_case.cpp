@@ -93,6 +93,6 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
   return c;
 }
 
-io::Capture simulate_case(const SyntheticCase& c) { return sim::simulate(c.scenario); }
+capture::Capture simulate_case(const SyntheticCase& c) { return sim::simulate(c.scenario); }
 
 }  // namespace leakmon::model

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "sim/scenario.hpp"
 
 namespace leakmon::model {
@@ -27,6 +27,6 @@ struct CaseSettings {
 // `effect` empty draws one of the eleven effects or "none" at random; otherwise that effect.
 SyntheticCase draw_case(std::uint64_t seed, const std::string& effect = "",
                         const CaseSettings& settings = {});
-io::Capture simulate_case(const SyntheticCase& c);
+capture::Capture simulate_case(const SyntheticCase& c);
 
 }  // namespace leakmon::model

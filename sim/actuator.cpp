@@ -11,16 +11,12 @@ ActuatorCoefficients actuator_coefficients(const Parameters& params, const Effec
   // A floor on the volumes keeps the equations finite if the piston is driven into a stop.
   c.V_min = 1e-3 * (params.V_dead + params.V_line);
   c.half_stroke = 0.5 * params.L;
-  c.ps = params.ps;
   c.pt = params.pt;
-  c.beta = params.beta;
   c.m = params.m;
-  c.b = params.b;
   c.K_s = params.K_s;
   c.Kv = params.Kv;
   c.u_max = params.u_max;
   c.dp_lin = params.dp_lin;
-  c.C_n = params.C_n;
   c.K_stop = params.K_stop;
   c.c_stop = params.c_stop;
   c.tau_spool = effects.spool_lag ? effects.spool_lag->tau : params.tau;
@@ -45,7 +41,17 @@ ActuatorCoefficients actuator_coefficients(const Parameters& params, const Effec
     c.lag_p1 = effects.sensor_lag->channel == PressureChannel::p1;
     c.lag_p2 = effects.sensor_lag->channel == PressureChannel::p2;
   }
+  apply_conditions(c, params, Oil::standard(), kReferenceTemperature, params.ps);
   return c;
+}
+
+void apply_conditions(ActuatorCoefficients& c, const Parameters& params, const Oil& oil,
+                      double oil_temperature_C, double ps0) noexcept {
+  c.r = oil.ratio(oil_temperature_C);
+  c.ps = ps0;
+  c.C_n = c.r * params.C_n;
+  c.b = params.b * friction_factor(c.r);
+  c.beta = params.beta * bulk_modulus_factor(oil_temperature_C);
 }
 
 }  // namespace leakmon::sim

@@ -12,6 +12,7 @@
 #include "sim/effects.hpp"
 #include "sim/friction.hpp"
 #include "sim/leakage.hpp"
+#include "sim/oil.hpp"
 #include "sim/parameters.hpp"
 #include "sim/piston.hpp"
 #include "sim/spool.hpp"
@@ -24,22 +25,31 @@ namespace leakmon::sim {
 // repeated geometry. An effect that is off has the value that makes its term vanish.
 struct ActuatorCoefficients {
   double A, V0, V_min, half_stroke;
-  double ps, pt, beta, m, b, K_s, Kv, u_max, dp_lin, C_n, K_stop, c_stop;
+  double pt, m, K_s, Kv, u_max, dp_lin, K_stop, c_stop;
+  // The operating conditions (apply_conditions): viscosity ratio r = nu(40)/nu(T), supply
+  // set-point ps0, and the coefficients that follow T: r C_n, b (0.5 + 0.5/r),
+  // beta (1 - 0.003 (T - 40)). Nominal (r = 1, ps0 = ps) unless conditions are applied.
+  double r, ps, C_n, b, beta;
   double tau_spool;                           // spool_lag's tau, else the nominal one
   double u_bias;                              // valve_bias u0
   double overlap;                             // valve_overlap d
   double ripple_dP, ripple_dQ, ripple_omega;  // supply_ripple (dQ: cos term, model check only)
   double droop_R_s;                           // supply_droop
-  double C_E;                                 // external_leakage ...
-  int external_chamber;                       //   ... from chamber 1 or 2
-  double F_C;                                 // coulomb_friction
-  double friction_velocity;                   // its tanh scale: 1e-3 unless widened
-  double alpha;                               // entrained_air
-  double lag_tau_s;                           // sensor_lag ...
-  bool lag_p1, lag_p2;                        //   ... on which transducer
+  double C_E;                // external_leakage (as stated; the plant schedules it) ...
+  int external_chamber;      //   ... from chamber 1 or 2
+  double F_C;                // coulomb_friction
+  double friction_velocity;  // its tanh scale: 1e-3 unless widened
+  double alpha;              // entrained_air
+  double lag_tau_s;          // sensor_lag ...
+  bool lag_p1, lag_p2;       //   ... on which transducer
 };
 
 ActuatorCoefficients actuator_coefficients(const Parameters& params, const Effects& effects);
+
+// MODEL.md "Drifting operating conditions": the oil at T [degC] and the supply set-point ps0
+// [Pa]. At T = 40 and ps0 = params.ps every coefficient is exactly the nominal one (r(40) = 1).
+void apply_conditions(ActuatorCoefficients& c, const Parameters& params, const Oil& oil,
+                      double oil_temperature_C, double ps0) noexcept;
 
 // Every flow and the supply pressure at one instant.
 struct ActuatorFlows {
@@ -49,13 +59,21 @@ struct ActuatorFlows {
   double q_supply;        // flow out of the supply port [m^3/s]
   double q_int;           // cross-port leakage 1 -> 2 [m^3/s]
   double q_ext1, q_ext2;  // external leakage to tank [m^3/s]
+  double C_L;             // internal leakage coefficient at the oil's temperature (r C_L)
 };
 
-// p1, p2 already clamped at 0 (no cavitation); w is the spool flow noise, C_L the internal
-// leakage coefficient in force at t.
+// Leak sizes are stated at 40 degC; the internal leak's flow follows the viscosity ratio.
+inline double internal_leak_coefficient(const ActuatorCoefficients& c, double C_L40) noexcept {
+  return c.r * C_L40;
+}
+
+// p1, p2 already clamped at 0 (no cavitation); w is the spool flow noise; C_L and C_E the
+// internal and external leakage coefficients in force at t (leak sizes are stated at 40 degC:
+// the internal leak follows the viscosity ratio r, the external one keeps its C_E, MODEL.md).
 [[gnu::always_inline]] inline ActuatorFlows actuator_flows(const ActuatorCoefficients& c, double t,
                                                            double xs, double w, double C_L,
-                                                           double p1, double p2) noexcept {
+                                                           double C_E, double p1,
+                                                           double p2) noexcept {
   ActuatorFlows f{};
   f.opening = xs + w;
   if (c.overlap > 0.0) f.opening = overlapped_opening(f.opening, c.overlap);
@@ -67,12 +85,13 @@ struct ActuatorFlows {
   f.q1 = valve.q1;
   f.q2 = valve.q2;
   f.q_supply = valve.q_supply;
-  f.q_int = cross_port_flow(C_L, p1, p2);
-  if (c.C_E != 0.0) {  // the model check's fit may try a negative C_E
+  f.C_L = internal_leak_coefficient(c, C_L);
+  f.q_int = cross_port_flow(f.C_L, p1, p2);
+  if (C_E != 0.0) {  // the model check's fit may try a negative C_E
     if (c.external_chamber == 1) {
-      f.q_ext1 = external_leak_flow(c.C_E, p1, c.pt);
+      f.q_ext1 = external_leak_flow(C_E, p1, c.pt);
     } else {
-      f.q_ext2 = external_leak_flow(c.C_E, p2, c.pt);
+      f.q_ext2 = external_leak_flow(C_E, p2, c.pt);
     }
   }
   return f;
@@ -89,12 +108,12 @@ struct ActuatorRates {
 // integrated pressures (an RK stage may dip below 0; the equations see them clamped).
 [[gnu::always_inline]] inline ActuatorRates actuator_rates(const ActuatorCoefficients& c, double t,
                                                            double spool_in, double w, double C_L,
-                                                           double xs, double x, double v,
-                                                           double p1_state,
+                                                           double C_E, double xs, double x,
+                                                           double v, double p1_state,
                                                            double p2_state) noexcept {
   const double p1 = std::max(p1_state, 0.0);
   const double p2 = std::max(p2_state, 0.0);
-  const ActuatorFlows f = actuator_flows(c, t, xs, w, C_L, p1, p2);
+  const ActuatorFlows f = actuator_flows(c, t, xs, w, C_L, C_E, p1, p2);
   ActuatorRates r;
   r.p1_clamped = p1;
   r.p2_clamped = p2;

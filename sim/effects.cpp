@@ -70,9 +70,15 @@ std::vector<EffectDescription> Effects::describe() const {
                     num("ramp_s", internal_leakage->ramp_s)}});
   }
   if (external_leakage) {
-    out.push_back({"external_leakage",
-                   {num("C_E", external_leakage->C_E),
-                    num("chamber", static_cast<double>(external_leakage->chamber))}});
+    EffectDescription ext{"external_leakage",
+                          {num("C_E", external_leakage->C_E),
+                           num("chamber", static_cast<double>(external_leakage->chamber))}};
+    // Listed only when set, so that a leak present from the start reads as MODEL.md's table.
+    if (external_leakage->onset_s != 0.0)
+      ext.params.push_back(num("onset_s", external_leakage->onset_s));
+    if (external_leakage->ramp_s != 0.0)
+      ext.params.push_back(num("ramp_s", external_leakage->ramp_s));
+    out.push_back(std::move(ext));
   }
   if (coulomb_friction) out.push_back({"coulomb_friction", {num("F_C", coulomb_friction->F_C)}});
   if (entrained_air) out.push_back({"entrained_air", {num("alpha", entrained_air->alpha)}});
@@ -120,6 +126,10 @@ void Effects::enable_unchecked(std::string_view name, std::span<const EffectPara
         const double chamber = number(name, param);
         if (chamber != 1.0 && chamber != 2.0) fail(name, "parameter 'chamber' must be 1 or 2");
         external_leakage->chamber = static_cast<int>(chamber);
+      } else if (param.name == "onset_s") {
+        external_leakage->onset_s = number(name, param);
+      } else if (param.name == "ramp_s") {
+        external_leakage->ramp_s = number(name, param);
       } else {
         fail(name, "unknown parameter '" + param.name + "'");
       }

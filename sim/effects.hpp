@@ -24,10 +24,13 @@ struct InternalLeakage {
   double onset_s = 0.0;
   double ramp_s = 0.0;
 };
-// Flow from one chamber to tank q_ext,i = C_E (p_i - pt).
+// Flow from one chamber to tank q_ext,i = C_E (p_i - pt), from onset_s on (a step, or a linear
+// ramp over ramp_s, like the internal leak's).
 struct ExternalLeakage {
   double C_E = 5e-13;  // m^3/(s Pa)
   int chamber = 1;     // 1 or 2
+  double onset_s = 0.0;
+  double ramp_s = 0.0;
 };
 // F_fric = F_C tanh(v / 1e-3).
 struct CoulombFriction {
@@ -102,8 +105,8 @@ struct Effects {
   bool any() const { return !describe().empty(); }
 
   // Switches on effect `name` with the given parameters (names as in MODEL.md; missing ones keep
-  // the defaults above; internal_leakage also takes onset_s and ramp_s). Throws EffectError for
-  // an unknown effect or parameter name or a wrongly typed value.
+  // the defaults above; internal_leakage and external_leakage also take onset_s and ramp_s). Throws
+  // EffectError for an unknown effect or parameter name or a wrongly typed value.
   void enable(std::string_view name, std::span<const EffectParameter> params = {});
   void disable(std::string_view name);
 

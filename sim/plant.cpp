@@ -54,7 +54,22 @@ Plant::Plant(const Parameters& params, const Effects& effects, std::uint64_t noi
     leak_ = {effects.internal_leakage->C_L, effects.internal_leakage->onset_s,
              effects.internal_leakage->ramp_s};
   }
+  if (effects.external_leakage) {
+    external_leak_ = {effects.external_leakage->C_E, effects.external_leakage->onset_s,
+                      effects.external_leakage->ramp_s};
+  }
+  set_conditions(kReferenceTemperature, params.ps);
   reset();
+}
+
+void Plant::set_conditions(double oil_temperature_C, double ps0) noexcept {
+  temperature_ = oil_temperature_C;
+  apply_conditions(c_, params_, oil_, oil_temperature_C, ps0);
+}
+
+void Plant::set_oil(const Oil& oil) {
+  oil_ = oil;
+  set_conditions(temperature_, c_.ps);
 }
 
 void Plant::reset() {
@@ -82,17 +97,26 @@ void Plant::set_internal_leak(double C_L, double onset_s, double ramp_s) noexcep
   leak_ = {C_L, onset_s, ramp_s};
 }
 
-PlantFlows Plant::evaluate(double t, double leak_t, double xs, double p1, double p2,
+namespace {
+
+// A stepped schedule is read at the step's midpoint, a ramp at t (see advance()).
+double scheduled(const LeakSchedule& leak, double t, double step_midpoint) noexcept {
+  return leak.at(leak.ramp_s > 0.0 ? t : step_midpoint);
+}
+
+}  // namespace
+
+PlantFlows Plant::evaluate(double t, double step_midpoint, double xs, double p1, double p2,
                            double w) const noexcept {
-  const double C_L = leak_.at(leak_t);
-  const ActuatorFlows a = actuator_flows(c_, t, xs, w, C_L, p1, p2);
-  return {a.ps, w, a.opening, a.q1, a.q2, a.q_supply, a.q_int, a.q_ext1, a.q_ext2, C_L};
+  const ActuatorFlows a = actuator_flows(c_, t, xs, w, scheduled(leak_, t, step_midpoint),
+                                         scheduled(external_leak_, t, step_midpoint), p1, p2);
+  return {a.ps, w, a.opening, a.q1, a.q2, a.q_supply, a.q_int, a.q_ext1, a.q_ext2, a.C_L};
 }
 
 void Plant::rates(double t, double spool_in, const Vector& y, Vector& dy) noexcept {
-  const ActuatorRates r = actuator_rates(c_, t, spool_in, noise_.at(t),
-                                         leak_.at(leak_.ramp_s > 0.0 ? t : step_midpoint_), y[kXs],
-                                         y[kX], y[kV], y[kP1], y[kP2]);
+  const ActuatorRates r = actuator_rates(
+      c_, t, spool_in, noise_.at(t), scheduled(leak_, t, step_midpoint_),
+      scheduled(external_leak_, t, step_midpoint_), y[kXs], y[kX], y[kV], y[kP1], y[kP2]);
   dy[kXs] = r.xs;
   dy[kX] = r.x;
   dy[kV] = r.v;
@@ -106,8 +130,8 @@ void Plant::rates(double t, double spool_in, const Vector& y, Vector& dy) noexce
       c_.lag_p2 ? transducer_lag_rate(r.p2_clamped, y[kP2Transducer], c_.lag_tau_s) : 0.0;
 
   if (ledger_) {
-    dy[kMassIn1] = std::exp(y[kP1] / params_.beta) * r.inflow1;
-    dy[kMassIn2] = std::exp(y[kP2] / params_.beta) * r.inflow2;
+    dy[kMassIn1] = std::exp(y[kP1] / c_.beta) * r.inflow1;
+    dy[kMassIn2] = std::exp(y[kP2] / c_.beta) * r.inflow2;
   } else {
     dy[kMassIn1] = dy[kMassIn2] = 0.0;
   }
@@ -139,7 +163,8 @@ void Plant::advance(double u, double t0, double dt) noexcept {
 }
 
 double Plant::leak_flow() const {
-  return cross_port_flow(leak_.at(time_), std::max(state_.p1, 0.0), std::max(state_.p2, 0.0));
+  return cross_port_flow(internal_leak_coefficient(c_, leak_.at(time_)), std::max(state_.p1, 0.0),
+                         std::max(state_.p2, 0.0));
 }
 
 PlantFlows Plant::flows() const {

@@ -15,6 +15,7 @@
 #include "sim/effects.hpp"
 #include "sim/flow_noise.hpp"
 #include "sim/leakage.hpp"
+#include "sim/oil.hpp"
 #include "sim/parameters.hpp"
 
 namespace leakmon::sim {
@@ -46,7 +47,8 @@ struct PlantFlows {
   double q_supply;        // flow out of the supply port [m^3/s]
   double q_int;           // cross-port leakage 1 -> 2 [m^3/s]
   double q_ext1, q_ext2;  // external leakage to tank [m^3/s]
-  double C_L;             // internal leakage coefficient in force now
+  double C_L;             // internal leakage coefficient in force now (r C_L: at the oil's
+                          // temperature, MODEL.md "Drifting operating conditions")
 };
 
 // The RK4 step used when a scenario leaves it at 0: chosen by accuracy (the step-halving test
@@ -79,6 +81,19 @@ class Plant {
 
   // Runtime leak injection (the daemon's sim driver): C_L from onset_s on, ramped over ramp_s.
   void set_internal_leak(double C_L, double onset_s, double ramp_s = 0.0) noexcept;
+  // Operating conditions (MODEL.md "Drifting operating conditions"), held until the next call:
+  // the oil temperature T [degC] and the supply set-point ps0 [Pa] (ripple and droop act on
+  // top). Recomputes the coefficients that follow T through the oil's viscosity ratio
+  // r = nu(40)/nu(T): C_n and C_L scale with r, b -> b (0.5 + 0.5/r), beta (and entrained
+  // air's E_l) -> beta (1 - 0.003 (T - 40)). At T = 40 and ps0 = ps every coefficient is
+  // exactly the nominal one. Allocation-free; Rig calls it once per sample.
+  void set_conditions(double oil_temperature_C, double ps0) noexcept;
+  // The oil whose viscosity T acts through (ISO VG 46 unless set); re-applies the conditions.
+  void set_oil(const Oil& oil);
+  double oil_temperature() const { return temperature_; }
+  double viscosity_ratio() const { return c_.r; }
+  double supply_setpoint() const { return c_.ps; }
+
   // Turns the mass ledger of PlantState on (costs two exp() per derivative evaluation).
   void enable_ledger(bool on) { ledger_ = on; }
 
@@ -90,8 +105,8 @@ class Plant {
  private:
   // The integrated state: PlantState's members in declaration order.
   using Vector = Eigen::Matrix<double, 10, 1>;
-  // leak_t: the time at which the leak schedule is read (see advance()).
-  PlantFlows evaluate(double t, double leak_t, double xs, double p1, double p2,
+  // step_midpoint: where a stepped leak schedule is read (see advance()).
+  PlantFlows evaluate(double t, double step_midpoint, double xs, double p1, double p2,
                       double w) const noexcept;
   void rates(double t, double spool_in, const Vector& y, Vector& dy) noexcept;
   void store(const Vector& y);
@@ -101,6 +116,9 @@ class Plant {
   ActuatorCoefficients c_;
   FlowNoise noise_;
   LeakSchedule leak_;
+  LeakSchedule external_leak_;  // C_L holds C_E; empty when external_leakage is off
+  Oil oil_ = Oil::standard();
+  double temperature_ = kReferenceTemperature;
   Vector y_;
   PlantState state_;
   double time_ = 0.0;

@@ -74,7 +74,12 @@ class Random {
 };
 
 // Stream numbers, so that switching one source of randomness off leaves the others unchanged.
-enum class RandomStream : std::uint64_t { reference = 1, flow_noise = 2, sensors = 3 };
+enum class RandomStream : std::uint64_t {
+  reference = 1,
+  flow_noise = 2,
+  sensors = 3,
+  sensor_faults = 4
+};
 
 constexpr std::uint64_t stream_seed(std::uint64_t seed, RandomStream stream) {
   return stream_seed(seed, static_cast<std::uint64_t>(stream));

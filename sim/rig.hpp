@@ -10,6 +10,7 @@
 #include "sim/plant.hpp"
 #include "sim/reference.hpp"
 #include "sim/scenario.hpp"
+#include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
 
 namespace leakmon::sim {
@@ -18,10 +19,12 @@ struct RigSample {
   double t;          // s
   double xref;       // m
   double u;          // V, as commanded (before valve_bias)
-  double x, p1, p2;  // measured (sensor chain applied)
+  double x, p1, p2;  // recorded (sensor chain and any sensor fault applied)
+  double ps, temp;   // recorded supply pressure [Pa] and oil temperature [degC]
   double q_int;      // true cross-port leak flow [m^3/s]
   double x_true, v_true, p1_true, p2_true, xs_true;
-  double ps_true;  // supply pressure (ripple, droop) [Pa]
+  double ps_true;    // supply pressure (set-point, ripple, droop) [Pa]
+  double temp_true;  // oil temperature [degC]
 };
 
 class Rig {
@@ -46,6 +49,7 @@ class Rig {
   Controller controller_;
   Plant plant_;
   Sensors sensors_;
+  SensorFaults faults_;
   std::uint64_t index_ = 0;
 };
 

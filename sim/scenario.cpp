@@ -30,7 +30,8 @@ struct EffectSpec {
 const std::vector<EffectSpec>& effect_specs() {
   static const std::vector<EffectSpec> specs = {
       {"internal_leakage", {{"C_L", 0.0, 1e-9}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
-      {"external_leakage", {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}}},
+      {"external_leakage",
+       {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
       {"coulomb_friction", {{"F_C", 0.0, 1e4}}},
       {"entrained_air", {{"alpha", 0.0, 1.0}}},
       {"valve_overlap", {{"d", 0.0, 0.5}}},
@@ -135,7 +136,10 @@ void read_reference(const config::ConfigNode& node, ReferenceSettings& reference
 void read_sensors(const config::ConfigNode& node, SensorSettings& sensors) {
   node.expect_keys({"enabled", "pressure_quantisation", "pressure_full_scale", "pressure_bits",
                     "pressure_noise_sigma", "position_quantisation", "position_resolution",
-                    "position_noise_sigma"});
+                    "position_noise_sigma", "temp_resolution", "temp_noise_sigma"});
+  sensors.temp_resolution = node.get_double("temp_resolution", sensors.temp_resolution, 1e-4, 10.0);
+  sensors.temp_noise_sigma =
+      node.get_double("temp_noise_sigma", sensors.temp_noise_sigma, 0.0, 10.0);
   sensors.enabled = node.get_bool("enabled", sensors.enabled);
   sensors.pressure_quantisation =
       node.get_bool("pressure_quantisation", sensors.pressure_quantisation);
@@ -153,9 +157,155 @@ void read_sensors(const config::ConfigNode& node, SensorSettings& sensors) {
       node.get_double("position_noise_sigma", sensors.position_noise_sigma, 0.0, 1e-1);
 }
 
+Oil read_oil(const config::ConfigNode& node) {
+  node.expect_keys({"grade", "nu40", "nu100"});
+  if (node.has("grade")) {
+    if (node.has("nu40") || node.has("nu100")) node.fail("give either grade or nu40 and nu100");
+    const auto grade = node.at("grade");
+    const auto oil = Oil::iso_vg(static_cast<int>(grade.as_int()));
+    if (!oil) grade.fail("ISO VG grade must be 32, 46 or 68 (or give nu40 and nu100)");
+    return *oil;
+  }
+  const double nu40 = node.get_double("nu40", 1.0, 1e4);
+  const double nu100 = node.get_double("nu100", 0.5, 1e4);
+  if (!(nu100 < nu40)) node.at("nu100").fail("nu100 must be below nu40");
+  return Oil(nu40, nu100);
+}
+
+TemperatureProfile read_temperature(const config::ConfigNode& node) {
+  using Kind = TemperatureProfile::Kind;
+  TemperatureProfile t;
+  const std::string profile =
+      node.get_choice("profile", {"constant", "warm_up", "cooler", "warm_up_cooler"}, "constant");
+  if (profile == "constant") {
+    node.expect_keys({"profile", "T"});
+    t.kind = Kind::constant;
+    t.T_work = node.get_double("T", kReferenceTemperature, -30.0, 150.0);
+    return t;
+  }
+  const bool warm = profile == "warm_up" || profile == "warm_up_cooler";
+  const bool cool = profile == "cooler" || profile == "warm_up_cooler";
+  std::vector<std::string> keys = {"profile", "T_work"};
+  if (warm) keys.insert(keys.end(), {"T0", "tau_s", "start_s"});
+  if (cool) keys.insert(keys.end(), {"amplitude", "period_s", "cooler_start_s"});
+  node.expect_keys(keys);
+  t.kind = profile == "warm_up"  ? Kind::warm_up
+           : profile == "cooler" ? Kind::cooler
+                                 : Kind::warm_up_cooler;
+  t.T_work = node.get_double("T_work", 50.0, -30.0, 150.0);
+  if (warm) {
+    t.T0 = node.get_double("T0", 20.0, -30.0, 150.0);
+    t.tau_s = node.get_double("tau_s", 600.0, 1.0, 1e6);
+    t.start_s = node.get_double("start_s", 0.0, 0.0, 1e7);
+  }
+  if (cool) {
+    t.amplitude = node.get_double("amplitude", 2.0, 0.0, 30.0);
+    t.period_s = node.get_double("period_s", 600.0, 1.0, 1e6);
+    t.cooler_start_s = node.get_double(
+        "cooler_start_s", profile == "warm_up_cooler" ? t.start_s + 3.0 * t.tau_s : 0.0, 0.0, 1e7);
+  }
+  if (t.minimum() < -30.0 || t.T_work + t.amplitude > 150.0) {
+    node.fail("the profile leaves -30..150 degC");
+  }
+  return t;
+}
+
+std::vector<SupplyChange> read_supply(const config::ConfigNode& node) {
+  if (!node.is_sequence()) node.fail("must be a list of {t_s, ps, ramp_s}");
+  std::vector<SupplyChange> changes;
+  for (const auto& item : node.items()) {
+    item.expect_keys({"t_s", "ps", "ramp_s"});
+    SupplyChange change;
+    change.t_s = item.get_double("t_s", 0.0, 1e7);
+    change.ps = item.get_double("ps", 1e5, 1e8);
+    change.ramp_s = item.get_double("ramp_s", 0.0, 0.0, 1e5);
+    if (!changes.empty() && change.t_s < changes.back().t_s + changes.back().ramp_s) {
+      item.at("t_s").fail("changes must be in time order and must not overlap the previous ramp");
+    }
+    changes.push_back(change);
+  }
+  return changes;
+}
+
+void read_conditions(const config::ConfigNode& node, OperatingConditions& conditions) {
+  node.expect_keys({"oil", "temperature", "supply"});
+  if (auto oil = node.find("oil")) conditions.oil = read_oil(*oil);
+  if (auto temperature = node.find("temperature")) {
+    conditions.temperature = read_temperature(*temperature);
+  }
+  if (auto supply = node.find("supply")) conditions.supply = read_supply(*supply);
+}
+
+Scenario::Record read_record(const config::ConfigNode& node) {
+  if (!node.is_sequence()) node.fail("must be a list of optional columns: ps, temp");
+  Scenario::Record record;
+  for (const auto& item : node.items()) {
+    const std::string column = item.as_string();
+    if (column == "ps") {
+      record.ps = true;
+    } else if (column == "temp") {
+      record.temp = true;
+    } else {
+      item.fail(fmt::format("unknown optional column '{}' (allowed: ps, temp)", column));
+    }
+  }
+  return record;
+}
+
+std::vector<SensorFault> read_faults(const config::ConfigNode& node,
+                                     const Scenario::Record& record) {
+  if (!node.is_sequence()) node.fail("must be a list of {type, channel, start_s, ...}");
+  std::vector<SensorFault> faults;
+  for (const auto& item : node.items()) {
+    SensorFault fault;
+    const std::string type =
+        item.get_choice("type", {"frozen", "saturated", "spikes", "dropout"}, "frozen");
+    if (!item.has("type")) item.fail("type is required (frozen, saturated, spikes or dropout)");
+    std::vector<std::string> keys = {"type", "channel", "start_s", "duration_s"};
+    if (type == "saturated") keys.emplace_back("level");
+    if (type == "spikes") keys.insert(keys.end(), {"rate_per_min", "magnitude"});
+    if (type == "dropout") keys.emplace_back("mode");
+    item.expect_keys(keys);
+    fault.kind = type == "frozen"      ? SensorFault::Kind::frozen
+                 : type == "saturated" ? SensorFault::Kind::saturated
+                 : type == "spikes"    ? SensorFault::Kind::spikes
+                                       : SensorFault::Kind::dropout;
+    if (!item.has("channel")) item.fail("channel is required (p1, p2, x, ps or temp)");
+    const std::string channel = item.get_choice("channel", {"p1", "p2", "x", "ps", "temp"}, "p1");
+    fault.channel = channel == "p1"   ? SensorChannel::p1
+                    : channel == "p2" ? SensorChannel::p2
+                    : channel == "x"  ? SensorChannel::x
+                    : channel == "ps" ? SensorChannel::ps
+                                      : SensorChannel::temp;
+    if ((fault.channel == SensorChannel::ps && !record.ps) ||
+        (fault.channel == SensorChannel::temp && !record.temp)) {
+      item.at("channel").fail(
+          fmt::format("channel {} is not recorded: add it to the scenario's record list", channel));
+    }
+    fault.start_s = item.get_double("start_s", 0.0, 0.0, 1e7);
+    if (item.has("duration_s")) fault.duration_s = item.get_double("duration_s", 0.002, 1e7);
+    if (type == "saturated") {
+      fault.high = item.get_choice("level", {"high", "low"}, "high") == "high";
+    }
+    if (type == "spikes") {
+      fault.rate_per_min = item.get_double("rate_per_min", fault.rate_per_min, 0.0, 3000.0);
+      const bool pressure = fault.channel == SensorChannel::p1 ||
+                            fault.channel == SensorChannel::p2 ||
+                            fault.channel == SensorChannel::ps;
+      // Defaults in the channel's unit: 3 MPa, 5 mm, 20 K.
+      const double fallback = pressure ? 3e6 : fault.channel == SensorChannel::x ? 5e-3 : 20.0;
+      fault.magnitude = item.get_double("magnitude", fallback, 0.0, pressure ? 1e8 : 1e3);
+    }
+    if (type == "dropout") fault.gap = item.get_choice("mode", {"zero", "gap"}, "zero") == "gap";
+    faults.push_back(fault);
+  }
+  return faults;
+}
+
 Scenario read_scenario(const config::ConfigNode& root) {
   root.expect_keys({"name", "controller", "duration_s", "seed", "sample_rate_hz",
-                    "integration_step_s", "reference", "params", "effects", "sensors"});
+                    "integration_step_s", "reference", "params", "effects", "sensors", "conditions",
+                    "faults", "record"});
   Scenario scenario;
   scenario.name = root.get_string("name", "scenario");
   scenario.controller = controller_kind_from_string(
@@ -167,6 +317,9 @@ Scenario read_scenario(const config::ConfigNode& root) {
   if (auto node = root.find("params")) read_parameters(*node, scenario.params);
   if (auto node = root.find("effects")) read_effects(*node, scenario.effects);
   if (auto node = root.find("sensors")) read_sensors(*node, scenario.sensors);
+  if (auto node = root.find("conditions")) read_conditions(*node, scenario.conditions);
+  if (auto node = root.find("record")) scenario.record = read_record(*node);
+  if (auto node = root.find("faults")) scenario.faults = read_faults(*node, scenario.record);
   if (auto node = root.find("integration_step_s")) {
     const double period = 1.0 / scenario.sample_rate_hz;
     const double h = node->as_double();
@@ -201,6 +354,10 @@ std::uint64_t Scenario::samples() const {
 }
 
 double integration_step(const Scenario& scenario) {
+  // Drifting conditions do not change the step: cold oil stiffens the hydraulic mode by
+  // 0.3 %/K, which at -30 degC puts the default step at h |lambda| = 2.3, still inside RK4's
+  // stability limit of 2.78; shortening it to a step that is not a divisor of the flow noise
+  // grid would cost more accuracy than it gains (docs/simulation.md).
   if (scenario.integration_step_s > 0.0) return scenario.integration_step_s;
   return automatic_integration_step(scenario.params, scenario.effects, scenario.sample_rate_hz);
 }

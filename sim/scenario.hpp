@@ -8,11 +8,13 @@
 #include <string_view>
 #include <vector>
 
+#include "sim/conditions.hpp"
 #include "sim/controller.hpp"
 #include "sim/effects.hpp"
 #include "sim/parameters.hpp"
 #include "sim/plant.hpp"
 #include "sim/reference.hpp"
+#include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
 
 namespace leakmon::sim {
@@ -27,6 +29,16 @@ struct Scenario {
   Parameters params;
   Effects effects;
   SensorSettings sensors;
+  // Oil temperature and supply set-point over time (MODEL.md "Drifting operating conditions");
+  // empty: the stationary rig at 40 degC and ps.
+  OperatingConditions conditions;
+  // Sensor faults in the recorded channels (MODEL.md "Sensor faults").
+  std::vector<SensorFault> faults;
+  // Optional capture columns beyond t,xref,u,x,p1,p2,q_int.
+  struct Record {
+    bool ps = false;    // supply pressure transducer
+    bool temp = false;  // oil temperature (RTD)
+  } record;
   double sample_rate_hz = 500.0;
   // RK4 step; 0 chooses automatic_integration_step(). Must divide the sample period.
   double integration_step_s = 0.0;

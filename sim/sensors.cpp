@@ -9,15 +9,57 @@ double SensorSettings::pressure_lsb() const {
   return pressure_full_scale / std::ldexp(1.0, pressure_bits);
 }
 
+double quantise_pressure(const SensorSettings& s, double p) noexcept {
+  const double lsb = s.pressure_lsb();
+  const double top_code = std::ldexp(1.0, s.pressure_bits) - 1.0;
+  return std::clamp(std::nearbyint(p / lsb), 0.0, top_code) * lsb;
+}
+
+double quantise_position(const SensorSettings& s, double x) noexcept {
+  // + 0.0 turns a rounded -0 into 0, so captures do not print "-0".
+  return std::nearbyint(x / s.position_resolution) * s.position_resolution + 0.0;
+}
+
+double quantise_temperature(const SensorSettings& s, double T) noexcept {
+  // Dividing by the (exact, for 0.1 K) number of steps per kelvin keeps 40.1 printing as 40.1.
+  const double steps_per_kelvin = 1.0 / s.temp_resolution;
+  return std::clamp(std::nearbyint(T * steps_per_kelvin) / steps_per_kelvin + 0.0, s.temp_min,
+                    s.temp_max);
+}
+
+namespace {
+// Stream of the optional transducers, derived from the sensor seed.
+constexpr std::uint64_t kAuxiliaryStream = 7;
+}  // namespace
+
 Sensors::Sensors(const SensorSettings& settings, const Effects& effects, std::uint64_t seed)
-    : settings_(settings), seed_(seed), random_(seed) {
+    : settings_(settings),
+      seed_(seed),
+      random_(seed),
+      aux_random_(stream_seed(seed, kAuxiliaryStream)) {
   if (effects.sensor_offset) {
     (effects.sensor_offset->channel == PressureChannel::p1 ? offset_p1_ : offset_p2_) =
         effects.sensor_offset->offset;
   }
 }
 
-void Sensors::reset() { random_.reseed(seed_); }
+void Sensors::reset() {
+  random_.reseed(seed_);
+  aux_random_.reseed(stream_seed(seed_, kAuxiliaryStream));
+}
+
+double Sensors::supply_pressure(double ps) noexcept {
+  const double noise = aux_random_.normal();
+  if (!settings_.enabled) return ps;
+  const double reading = ps + settings_.pressure_noise_sigma * noise;
+  return settings_.pressure_quantisation ? quantise_pressure(settings_, reading) : reading;
+}
+
+double Sensors::temperature(double T) noexcept {
+  const double noise = aux_random_.normal();
+  if (!settings_.enabled) return T;
+  return quantise_temperature(settings_, T + settings_.temp_noise_sigma * noise);
+}
 
 double Sensors::pressure(double p, double offset) noexcept {
   // Always drawn, so that switching a stage off leaves the other channels' noise unchanged.
@@ -25,11 +67,7 @@ double Sensors::pressure(double p, double offset) noexcept {
   double reading = p + offset;
   if (!settings_.enabled) return reading;
   reading += settings_.pressure_noise_sigma * noise;
-  if (settings_.pressure_quantisation) {
-    const double lsb = settings_.pressure_lsb();
-    const double top_code = std::ldexp(1.0, settings_.pressure_bits) - 1.0;
-    reading = std::clamp(std::nearbyint(reading / lsb), 0.0, top_code) * lsb;
-  }
+  if (settings_.pressure_quantisation) reading = quantise_pressure(settings_, reading);
   return reading;
 }
 
@@ -41,11 +79,7 @@ Measurement Sensors::measure(double x, double p1_transducer, double p2_transduce
   m.x = x;
   if (settings_.enabled) {
     m.x += settings_.position_noise_sigma * noise;
-    if (settings_.position_quantisation) {
-      // + 0.0 turns a rounded -0 into 0, so captures do not print "-0".
-      m.x =
-          std::nearbyint(m.x / settings_.position_resolution) * settings_.position_resolution + 0.0;
-    }
+    if (settings_.position_quantisation) m.x = quantise_position(settings_, m.x);
   }
   return m;
 }

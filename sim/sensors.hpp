@@ -19,9 +19,20 @@ struct SensorSettings {
   bool position_quantisation = true;
   double position_resolution = 10e-6;  // m
   double position_noise_sigma = 5e-6;  // m
+  // Oil temperature (capture column temp): a Pt100 RTD with a 4-20 mA transmitter ranged
+  // -50..150 degC, read to 0.1 K with 0.05 K of noise.
+  double temp_resolution = 0.1;    // K
+  double temp_noise_sigma = 0.05;  // K
+  double temp_min = -50.0;         // degC
+  double temp_max = 150.0;         // degC
 
   double pressure_lsb() const;
 };
+
+// The quantisers of the chain (also used to re-quantise a spiked reading).
+double quantise_pressure(const SensorSettings& s, double p) noexcept;  // clamped to the range
+double quantise_position(const SensorSettings& s, double x) noexcept;
+double quantise_temperature(const SensorSettings& s, double T) noexcept;  // clamped too
 
 struct Measurement {
   double x, p1, p2;
@@ -34,6 +45,10 @@ class Sensors {
   void reset();
   // p1_transducer, p2_transducer: the pressures after any transducer lag (plant states).
   Measurement measure(double x, double p1_transducer, double p2_transducer) noexcept;
+  // The optional transducers (supply pressure: the pressure chain; oil temperature: the RTD),
+  // with noise from a stream of their own, so that the p1, p2, x readings stay as without them.
+  double supply_pressure(double ps) noexcept;
+  double temperature(double T) noexcept;
 
  private:
   double pressure(double p, double offset) noexcept;
@@ -42,6 +57,7 @@ class Sensors {
   double offset_p1_ = 0.0, offset_p2_ = 0.0;
   std::uint64_t seed_;
   Random random_;
+  Random aux_random_;
 };
 
 }  // namespace leakmon::sim

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <span>
 #include <variant>
 
 #include "sim/rig.hpp"
@@ -12,8 +13,21 @@ namespace {
 
 const std::vector<std::string> kColumns = {"t", "xref", "u", "x", "p1", "p2", "q_int"};
 
-std::array<double, 7> row(const RigSample& s) {
-  return {s.t, s.xref, s.u, s.x, s.p1, s.p2, s.q_int};
+// The capture's columns: the fixed seven, then the optional ones the scenario records.
+std::vector<std::string> columns(const Scenario& scenario) {
+  std::vector<std::string> out = kColumns;
+  if (scenario.record.ps) out.emplace_back("ps");
+  if (scenario.record.temp) out.emplace_back("temp");
+  return out;
+}
+
+// One row in the order of columns(); returns the number of values.
+std::size_t row(const Scenario& scenario, const RigSample& s, std::array<double, 9>& out) {
+  out = {s.t, s.xref, s.u, s.x, s.p1, s.p2, s.q_int, 0.0, 0.0};
+  std::size_t n = 7;
+  if (scenario.record.ps) out[n++] = s.ps;
+  if (scenario.record.temp) out[n++] = s.temp;
+  return n;
 }
 
 std::string format_params(const std::vector<EffectParameter>& params) {
@@ -63,8 +77,8 @@ std::string overridden_parameters(const Parameters& p) {
 
 }  // namespace
 
-io::Metadata capture_metadata(const Scenario& scenario) {
-  io::Metadata meta;
+capture::Metadata capture_metadata(const Scenario& scenario) {
+  capture::Metadata meta;
   meta.emplace_back("sample_rate_hz", fmt::format("{:g}", scenario.sample_rate_hz));
   meta.emplace_back(
       "source", fmt::format("sim {} seed {}",
@@ -93,28 +107,59 @@ io::Metadata capture_metadata(const Scenario& scenario) {
                         s.position_resolution, s.position_quantisation ? "" : " (unquantised)",
                         s.position_noise_sigma)
           : std::string("ideal (true values)"));
+  // Drifting conditions, faults and optional transducers: listed only when present, so that a
+  // stationary scenario's metadata reads as before.
+  const OperatingConditions& c = scenario.conditions;
+  if (c.temperature) {
+    meta.emplace_back("oil", fmt::format("{}nu40={:g} nu100={:g} (Walther, ASTM D341)",
+                                         c.oil.name().empty() ? "" : c.oil.name() + " ",
+                                         c.oil.nu40(), c.oil.nu100()));
+    meta.emplace_back("temperature", c.temperature->describe());
+  }
+  for (const SupplyChange& change : c.supply) {
+    meta.emplace_back("supply_change", fmt::format("t_s={:g} ps={:g} ramp_s={:g}", change.t_s,
+                                                   change.ps, change.ramp_s));
+  }
+  for (const SensorFault& fault : scenario.faults) {
+    meta.emplace_back("sensor_fault", fault.describe());
+  }
+  if (scenario.record.ps) {
+    meta.emplace_back("ps_sensor", "supply pressure, the pressure chain above");
+  }
+  if (scenario.record.temp) {
+    meta.emplace_back(
+        "temp_sensor",
+        s.enabled ? fmt::format("RTD resolution {:g} K noise {:g} K range {:g}..{:g} degC",
+                                s.temp_resolution, s.temp_noise_sigma, s.temp_min, s.temp_max)
+                  : std::string("ideal (true values)"));
+  }
   return meta;
 }
 
-io::Capture simulate(const Scenario& scenario) {
-  io::Capture capture;
+capture::Capture simulate(const Scenario& scenario) {
+  capture::Capture capture;
   capture.metadata = capture_metadata(scenario);
-  capture.columns = kColumns;
+  capture.columns = columns(scenario);
   const std::uint64_t n = scenario.samples();
-  capture.values.assign(kColumns.size(), std::vector<double>(n));
+  capture.values.assign(capture.columns.size(), std::vector<double>(n));
   Rig rig(scenario);
+  std::array<double, 9> values{};
   for (std::uint64_t k = 0; k < n; ++k) {
-    const auto values = row(rig.step());
-    for (std::size_t c = 0; c < values.size(); ++c) capture.values[c][k] = values[c];
+    const std::size_t count = row(scenario, rig.step(), values);
+    for (std::size_t c = 0; c < count; ++c) capture.values[c][k] = values[c];
   }
   return capture;
 }
 
 void simulate_to_file(const Scenario& scenario, const std::string& path) {
-  io::CaptureWriter writer(path, kColumns, capture_metadata(scenario));
+  capture::CaptureWriter writer(path, columns(scenario), capture_metadata(scenario));
   Rig rig(scenario);
   const std::uint64_t n = scenario.samples();
-  for (std::uint64_t k = 0; k < n; ++k) writer.write_row(row(rig.step()));
+  std::array<double, 9> values{};
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::size_t count = row(scenario, rig.step(), values);
+    writer.write_row(std::span<const double>(values.data(), count));
+  }
   writer.close();
 }
 

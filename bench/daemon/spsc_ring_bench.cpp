@@ -40,8 +40,9 @@ void push_pop_same_thread(benchmark::State& state) {
   SpscRing<Sample> ring(1024);
   Sample sample;
   for (auto _ : state) {
-    ring.try_push(sample);
-    ring.try_pop(sample);
+    const bool pushed = ring.try_push(sample);
+    const bool popped = ring.try_pop(sample);
+    benchmark::DoNotOptimize(pushed && popped);
     benchmark::DoNotOptimize(sample);
   }
   state.SetItemsProcessed(state.iterations());

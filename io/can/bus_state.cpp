@@ -18,6 +18,19 @@ const char* to_string(BusState state) {
   return "unknown";
 }
 
+DeviceStatus device_status(BusState state) noexcept {
+  switch (state) {
+    case BusState::active:
+      return DeviceStatus::ok;
+    case BusState::warning:
+    case BusState::passive:
+      return DeviceStatus::maintenance_required;
+    case BusState::bus_off:
+      return DeviceStatus::failure;
+  }
+  return DeviceStatus::failure;
+}
+
 ErrorFrameEffect interpret_error_frame(const CanFrame& frame) noexcept {
   ErrorFrameEffect effect;
   const std::uint32_t classes = frame.id;

@@ -7,12 +7,16 @@
 #include <cstdint>
 
 #include "io/can/frame.hpp"
+#include "io/device_status.hpp"
 
 namespace leakmon::io::can {
 
 enum class BusState : std::uint8_t { active, warning, passive, bus_off };
 
 const char* to_string(BusState state);
+// NE 107: error-active is good; error-warning and error-passive still deliver frames but the
+// bus is degrading (maintenance required); bus-off delivers nothing (failure).
+DeviceStatus device_status(BusState state) noexcept;
 
 struct ErrorFrameEffect {
   bool changes_state = false;

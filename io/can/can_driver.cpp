@@ -110,7 +110,7 @@ void CanDriver::on_error_frame(const CanFrame& frame) noexcept {
   note_error(effect.description);
 }
 
-ReadStatus CanDriver::read(const Tick& tick, std::span<double> values) {
+ReadStatus CanDriver::read(const Tick& tick, std::span<double> values) noexcept {
   if (socket_) {
     // Frames are stamped on the tick's clock as "this long before now"; taking now as the
     // tick's time errs only by the wake-up latency, and works for a simulated clock too.
@@ -169,7 +169,10 @@ ReadStatus CanDriver::read(const Tick& tick, std::span<double> values) {
 
 DriverHealth CanDriver::health() const {
   DriverHealth h;
-  h.state = link_down_.load() ? "interface-down" : to_string(bus_state_.load());
+  const bool link_down = link_down_.load();
+  const BusState bus = bus_state_.load();
+  h.status = link_down ? DeviceStatus::failure : device_status(bus);
+  h.detail = link_down ? "interface-down" : to_string(bus);
   h.last_error = last_error_.load();
   h.errors = errors_.load();
   h.stale_values = stale_values_.load();

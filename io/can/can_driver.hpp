@@ -64,7 +64,7 @@ class CanDriver final : public Driver {
   std::span<const std::string> channels() const override { return channels_; }
   void start() override;
   void stop() override;
-  ReadStatus read(const Tick& tick, std::span<double> values) override;
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   DriverHealth health() const override;
 
   CanCounters counters() const;

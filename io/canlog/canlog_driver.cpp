@@ -65,7 +65,7 @@ void CanlogDriver::start() {
   decoder_.clear();
 }
 
-ReadStatus CanlogDriver::read(const Tick& tick, std::span<double> values) {
+ReadStatus CanlogDriver::read(const Tick& tick, std::span<double> values) noexcept {
   if (frames_.empty()) return ReadStatus::end_of_stream;
   const std::int64_t log_start = frames_.front().time_ns;
   if (!started_clock_) {
@@ -110,7 +110,9 @@ std::optional<double> CanlogDriver::source_time() const {
 
 DriverHealth CanlogDriver::health() const {
   DriverHealth h;
-  h.state = to_string(bus_state_.load());
+  const can::BusState bus = bus_state_.load();
+  h.status = can::device_status(bus);
+  h.detail = to_string(bus);
   h.last_error = last_error_.load();
   h.errors = errors_.load() + short_frames_.load();
   h.stale_values = stale_values_.load();

@@ -53,7 +53,7 @@ class CanlogDriver final : public Driver {
   // Loads the log; throws DriverError `file:line:column: message` for a malformed line.
   void start() override;
   void stop() override {}
-  ReadStatus read(const Tick& tick, std::span<double> values) override;
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override;
   DriverHealth health() const override;
 

@@ -27,7 +27,7 @@ class ModbusDriver final : public Driver {
   void start() override { poller_.start(); }
   void stop() override { poller_.stop(); }
 
-  ReadStatus read(const Tick& tick, std::span<double> values) override {
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override {
     const auto& specs = poller_.config().channels;
     const std::size_t n = std::min(values.size(), specs.size());
     const bool have_snapshot = poller_.latest(snapshot_);

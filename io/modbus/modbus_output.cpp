@@ -90,7 +90,7 @@ AlarmOutputSpec parse_output(const config::ConfigNode& node) {
 // a writer thread (started with the first event, so that check-config never touches the PLC)
 // writes it, rewrites it every refresh_ms so a restarted PLC learns it again, and reconnects
 // with backoff when the device is away.
-class ModbusAlarmOutput final : public daemon::EventSink {
+class ModbusAlarmOutput final : public EventSink {
  public:
   explicit ModbusAlarmOutput(AlarmOutputSpec spec) : spec_(std::move(spec)) {}
   ~ModbusAlarmOutput() override {
@@ -102,15 +102,13 @@ class ModbusAlarmOutput final : public daemon::EventSink {
     if (writer_.joinable()) writer_.join();
   }
 
-  void publish(const daemon::Event& event) override {
+  void publish(const Event& event) override {
     ensure_started();
-    if (event.kind != daemon::EventKind::alarm_raised &&
-        event.kind != daemon::EventKind::alarm_cleared)
-      return;
+    if (event.kind != EventKind::alarm_raised && event.kind != EventKind::alarm_cleared) return;
     if (!spec_.alarm.empty() && event.alarm != spec_.alarm) return;
     if (!spec_.actuator.empty() && event.actuator != spec_.actuator) return;
     const std::string key = event.actuator + "\n" + event.alarm;
-    if (event.kind == daemon::EventKind::alarm_raised) {
+    if (event.kind == EventKind::alarm_raised) {
       active_.insert(key);
     } else {
       active_.erase(key);
@@ -202,7 +200,7 @@ class ModbusAlarmOutput final : public daemon::EventSink {
 
 }  // namespace
 
-std::unique_ptr<daemon::EventSink> make_modbus_output(const config::ConfigNode& node) {
+std::unique_ptr<EventSink> make_modbus_output(const config::ConfigNode& node) {
   return std::make_unique<ModbusAlarmOutput>(parse_output(node));
 }
 

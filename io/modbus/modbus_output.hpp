@@ -6,12 +6,12 @@
 #include <memory>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/event.hpp"
+#include "io/event.hpp"
 
 namespace leakmon::io {
 
 // `node` is the output's YAML mapping, including `name:` and `type: modbus`. Validates every
 // field (file:line:column errors); opens no connection until the first event or flush.
-std::unique_ptr<daemon::EventSink> make_modbus_output(const config::ConfigNode& node);
+std::unique_ptr<EventSink> make_modbus_output(const config::ConfigNode& node);
 
 }  // namespace leakmon::io

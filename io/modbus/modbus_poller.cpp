@@ -19,6 +19,14 @@ std::string_view to_string_state(int state) {
   return kNames[state];
 }
 
+// NE 107 per link state: connecting is an intended, temporary invalid output; degraded (some
+// requests refused, the rest still served) still delivers values but needs attention.
+DeviceStatus device_status_of(int state) {
+  constexpr DeviceStatus kStatus[] = {DeviceStatus::function_check, DeviceStatus::ok,
+                                      DeviceStatus::maintenance_required, DeviceStatus::failure};
+  return kStatus[state];
+}
+
 }  // namespace
 
 ModbusPoller::ModbusPoller(ModbusConfig config)
@@ -56,7 +64,8 @@ DriverHealth ModbusPoller::health() const {
   DriverHealth health;
   {
     std::lock_guard lock(mutex_);
-    health.state = to_string_state(static_cast<int>(state_));
+    health.status = device_status_of(static_cast<int>(state_));
+    health.detail = to_string_state(static_cast<int>(state_));
     health.last_error = last_error_;
   }
   health.errors = errors_.load(std::memory_order_relaxed);

@@ -8,11 +8,11 @@
 namespace leakmon::io {
 
 ReplayDriver::ReplayDriver(ReplaySettings settings) : settings_(std::move(settings)) {
-  CaptureReader header(settings_.path);
+  capture::CaptureReader header(settings_.path);
   select_columns(header.columns());
 }
 
-ReplayDriver::ReplayDriver(ReplaySettings settings, std::shared_ptr<const Capture> capture)
+ReplayDriver::ReplayDriver(ReplaySettings settings, std::shared_ptr<const capture::Capture> capture)
     : settings_(std::move(settings)), capture_(std::move(capture)) {
   select_columns(capture_->columns);
   bind_columns();
@@ -45,8 +45,8 @@ void ReplayDriver::bind_columns() {
 void ReplayDriver::start() {
   if (!capture_) {
     try {
-      capture_ = std::make_shared<const Capture>(read_capture(settings_.path));
-    } catch (const CaptureError& e) {
+      capture_ = std::make_shared<const capture::Capture>(capture::read_capture(settings_.path));
+    } catch (const capture::CaptureError& e) {
       throw DriverError(e.what());
     }
     bind_columns();
@@ -62,7 +62,7 @@ void ReplayDriver::start() {
 
 double ReplayDriver::sample_rate_hz() const { return capture_ ? capture_->sample_rate_hz() : 0.0; }
 
-ReadStatus ReplayDriver::read(const Tick& /*tick*/, std::span<double> values) {
+ReadStatus ReplayDriver::read(const Tick& /*tick*/, std::span<double> values) noexcept {
   const std::size_t rows = t_ ? t_->size() : 0;
   if (next_row_ >= rows) {
     if (!settings_.loop || rows < 2) return ReadStatus::end_of_stream;
@@ -99,7 +99,7 @@ std::unique_ptr<Driver> make_replay_driver(const config::ConfigNode& node) {
     return std::make_unique<ReplayDriver>(settings);
   } catch (const DriverError& e) {
     path_node.fail(e.what());
-  } catch (const CaptureError& e) {
+  } catch (const capture::CaptureError& e) {
     path_node.fail(e.what());
   }
 }

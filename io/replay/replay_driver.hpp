@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "config/yaml_reader.hpp"
-#include "io/capture/capture.hpp"
 #include "io/driver.hpp"
 
 namespace leakmon::io {
@@ -27,13 +27,13 @@ class ReplayDriver final : public Driver {
   // From a file: reads the header now (channels are known at once), the rows in start().
   explicit ReplayDriver(ReplaySettings settings);
   // From a capture already in memory (the in-process replay of daemon/replay.hpp).
-  ReplayDriver(ReplaySettings settings, std::shared_ptr<const Capture> capture);
+  ReplayDriver(ReplaySettings settings, std::shared_ptr<const capture::Capture> capture);
 
   const std::string& name() const override { return settings_.name; }
   std::span<const std::string> channels() const override { return channels_; }
   void start() override;
   void stop() override {}
-  ReadStatus read(const Tick& tick, std::span<double> values) override;
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override { return source_time_; }
 
   std::size_t rows() const { return capture_ ? capture_->rows() : 0; }
@@ -44,7 +44,7 @@ class ReplayDriver final : public Driver {
   void bind_columns();
 
   ReplaySettings settings_;
-  std::shared_ptr<const Capture> capture_;
+  std::shared_ptr<const capture::Capture> capture_;
   std::vector<std::string> channels_;
   std::vector<const std::vector<double>*> columns_;  // one per channel, into capture_
   const std::vector<double>* t_ = nullptr;

@@ -24,25 +24,34 @@ double field(const sim::RigSample& s, std::size_t index) {
       return s.p1;
     case 4:
       return s.p2;
-    default:
+    case 5:
       return s.q_int;
+    case 6:
+      return s.ps;
+    default:
+      return s.temp;
   }
 }
 
 }  // namespace
 
 SimDriver::SimDriver(SimSettings settings) : settings_(std::move(settings)) {
+  std::vector<std::string> all(kSimChannels.begin(), kSimChannels.end());
+  all.insert(all.end(), kSimOptionalChannels.begin(), kSimOptionalChannels.end());
   std::vector<std::string> wanted = settings_.channels;
-  if (wanted.empty()) wanted.assign(kSimChannels.begin(), kSimChannels.end());
+  if (wanted.empty()) {
+    wanted.assign(kSimChannels.begin(), kSimChannels.end());
+    if (settings_.scenario.record.ps) wanted.emplace_back("ps");
+    if (settings_.scenario.record.temp) wanted.emplace_back("temp");
+  }
   for (const auto& name : wanted) {
-    const auto it = std::find_if(kSimChannels.begin(), kSimChannels.end(),
-                                 [&](const char* c) { return name == c; });
-    if (it == kSimChannels.end()) {
+    const auto it = std::find(all.begin(), all.end(), name);
+    if (it == all.end()) {
       throw DriverError(fmt::format("sim driver '{}': no channel '{}' (it has: {})", settings_.name,
-                                    name, fmt::join(kSimChannels, ", ")));
+                                    name, fmt::join(all, ", ")));
     }
     channels_.push_back(name);
-    fields_.push_back(static_cast<std::size_t>(it - kSimChannels.begin()));
+    fields_.push_back(static_cast<std::size_t>(it - all.begin()));
   }
 }
 
@@ -53,7 +62,7 @@ void SimDriver::start() {
   source_time_.reset();
 }
 
-ReadStatus SimDriver::read(const Tick& /*tick*/, std::span<double> values) {
+ReadStatus SimDriver::read(const Tick& /*tick*/, std::span<double> values) noexcept {
   const sim::RigSample sample = rig_->step();
   for (std::size_t i = 0; i < fields_.size() && i < values.size(); ++i) {
     values[i] = field(sample, fields_[i]);

@@ -31,6 +31,9 @@ struct SimSettings {
 
 // What the rig offers, in capture column names (FORMATS.md).
 inline constexpr std::array<const char*, 6> kSimChannels = {"xref", "u", "x", "p1", "p2", "q_int"};
+// Optional transducers (supply pressure, oil temperature): offered when named in `channels`,
+// and part of the default set when the scenario records them (its `record:` list).
+inline constexpr std::array<const char*, 2> kSimOptionalChannels = {"ps", "temp"};
 
 class SimDriver final : public Driver {
  public:
@@ -40,7 +43,7 @@ class SimDriver final : public Driver {
   std::span<const std::string> channels() const override { return channels_; }
   void start() override;
   void stop() override {}
-  ReadStatus read(const Tick& tick, std::span<double> values) override;
+  ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override { return source_time_; }
 
  private:

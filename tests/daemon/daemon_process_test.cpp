@@ -11,8 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "capture/capture.hpp"
 #include "daemon/http_endpoint.hpp"
-#include "io/capture/capture.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -71,8 +71,8 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   sim::Scenario scenario = sim::preset("paper-fig10", 5);
   scenario.duration_s = 26.0;
   scenario.effects.internal_leakage->onset_s = kOnset;
-  const io::Capture capture = sim::simulate(scenario);
-  io::write_capture(dir + "/capture.csv", capture);
+  const capture::Capture capture = sim::simulate(scenario);
+  capture::write_capture(dir + "/capture.csv", capture);
 
   const int port = free_port();
   const std::string cfg = dir + "/leakmon.yaml";
@@ -93,6 +93,15 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   EXPECT_NE(metrics.find("leakmon_build_info{version="), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_ring_drops_total{group=\"main\"}"), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_loop_wakeup_latency_seconds_bucket"), std::string::npos);
+  // Each transducer channel's NE 107 status (detect/sensor_plausibility.hpp), in both texts.
+  EXPECT_NE(metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"p1\",status=\"ok\"} 1"),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(
+      metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"x\",status=\"failure\"} 0"),
+      std::string::npos);
+  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/status").body.find("channel p2: ok"),
+            std::string::npos);
 
   // A valid change applies; a broken file is rejected with its location and changes nothing.
   const std::string events = dir + "/events.jsonl";
@@ -162,7 +171,7 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   ASSERT_GE(files.size(), 1u);
   std::uint64_t row = 0;
   for (const auto& file : files) {
-    const io::Capture recorded = io::read_capture(file);
+    const capture::Capture recorded = capture::read_capture(file);
     for (std::size_t i = 0; i < recorded.rows(); ++i, ++row) {
       ASSERT_LT(row, capture.rows());
       ASSERT_EQ(recorded.column("t")[i], capture.column("t")[row]) << file << " row " << i;

@@ -24,7 +24,7 @@ TEST(SimDriver, ReproducesTheBatchSimulationWithTheLeakInjectedAtItsTime) {
   leak.C_L = 2.0e-12;
   leak.onset_s = 2.0;
   scenario.effects.internal_leakage = leak;
-  const io::Capture reference = sim::simulate(scenario);
+  const capture::Capture reference = sim::simulate(scenario);
 
   auto driver = io::make_sim_driver(config::ConfigNode::load_string(
       "{name: rig, type: sim, scenario: healthy-ft, seed: 9, leak: {C_L: 2.0e-12, onset_s: 2}}",
@@ -51,13 +51,13 @@ TEST(SimDriver, ReproducesTheBatchSimulationWithTheLeakInjectedAtItsTime) {
 }
 
 TEST(ReplayDriver, LoopsWithTimeContinuing) {
-  io::Capture capture;
+  capture::Capture capture;
   capture.columns = {"t", "p1", "x"};
   capture.values = {{0.0, 0.002, 0.004}, {1.0, 2.0, 3.0}, {0.1, 0.2, 0.3}};
   io::ReplaySettings settings;
   settings.loop = true;
   settings.channels = {"x"};
-  io::ReplayDriver driver(settings, std::make_shared<const io::Capture>(capture));
+  io::ReplayDriver driver(settings, std::make_shared<const capture::Capture>(capture));
   driver.start();
   ASSERT_EQ(driver.channels().size(), 1u);
   std::vector<double> value(1);
@@ -68,7 +68,7 @@ TEST(ReplayDriver, LoopsWithTimeContinuing) {
     EXPECT_EQ(value[0], capture.values[2][static_cast<std::size_t>(i % 3)]);
   }
   settings.channels = {"p9"};
-  EXPECT_THROW(io::ReplayDriver(settings, std::make_shared<const io::Capture>(capture)),
+  EXPECT_THROW(io::ReplayDriver(settings, std::make_shared<const capture::Capture>(capture)),
                io::DriverError);
 }
 

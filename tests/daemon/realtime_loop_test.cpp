@@ -18,8 +18,8 @@
 namespace leakmon::daemon {
 namespace {
 
-std::shared_ptr<const io::Capture> ramp_capture(std::size_t rows) {
-  auto capture = std::make_shared<io::Capture>();
+std::shared_ptr<const capture::Capture> ramp_capture(std::size_t rows) {
+  auto capture = std::make_shared<capture::Capture>();
   capture->path = "ramp";
   capture->columns = {"t", "p1", "p2"};
   capture->values.assign(3, {});

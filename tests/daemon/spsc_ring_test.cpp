@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <limits>
+#include <stdexcept>
 #include <thread>
 
 namespace leakmon::daemon {
@@ -26,6 +28,16 @@ TEST(SpscRing, HoldsExactlyItsCapacityAndKeepsOrder) {
   }
   EXPECT_FALSE(ring.try_pop(value));
   EXPECT_EQ(ring.front(), nullptr);
+}
+
+TEST(SpscRing, RejectsCapacitiesItCannotIndex) {
+  EXPECT_THROW(SpscRing<int>(0), std::invalid_argument);
+  // capacity + 1 slots would wrap the index arithmetic (or the allocation size).
+  EXPECT_THROW(SpscRing<int>(std::numeric_limits<std::size_t>::max()), std::invalid_argument);
+  EXPECT_THROW(SpscRing<std::uint64_t>(std::numeric_limits<std::ptrdiff_t>::max() / 8),
+               std::invalid_argument);
+  const SpscRing<int> one(1);
+  EXPECT_EQ(one.capacity(), 1u);
 }
 
 TEST(SpscRing, WrapsAroundManyTimes) {

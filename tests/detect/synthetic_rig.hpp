@@ -10,6 +10,7 @@
 
 #include "detect/detector.hpp"
 #include "detect/valve_flow.hpp"
+#include "sim/oil.hpp"
 #include "sim/parameters.hpp"
 
 namespace leakmon::test {
@@ -30,6 +31,15 @@ struct SyntheticRig {
   int crossing_hops = 0;
   double spring = 80e3, area = 6.334e-4;
   sim::Parameters valve;  // the rig table: ps, pt, u_max, dp_lin
+  // Drifting conditions (MODEL.md): oil temperature [degC] at time t (laminar leaks, the null
+  // leakage included, follow the viscosity ratio; leak and null_leak are stated at 40 degC),
+  // reported as Observation::temp when report_temp; the supply pressure at time t, reported as
+  // Observation::ps when report_supply.
+  double (*temperature)(double t) = nullptr;
+  sim::Oil oil = sim::Oil::standard();
+  bool report_temp = false;
+  double (*supply)(double t) = nullptr;
+  bool report_supply = false;
   std::mt19937_64 rng{1};
 
   double t = 0.0;
@@ -48,18 +58,24 @@ struct SyntheticRig {
     }
     const double previous_x = x;
     x += std::clamp(target - x, -0.01, 0.01);  // moves at up to 0.25 m/s, then rests
-    const double leak_now = t >= onset ? leak : 0.0;
+    const double temp = temperature != nullptr ? temperature(t) : 40.0;
+    const double r = oil.ratio(temp);
+    const double leak_now = (t >= onset ? leak : 0.0) * r;
     const double dp = spring * x / area;
-    const double p_mid = 0.5 * (valve.ps + valve.pt);
+    sim::Parameters now = valve;
+    if (supply != nullptr) now.ps = supply(t);
+    const double p_mid = 0.5 * (now.ps + now.pt);
     detect::Observation o;
     o.t = t;
     o.p1 = p_mid + dp / 2 + 2e3 * normal(rng);
     o.p2 = p_mid - dp / 2 + 2e3 * normal(rng);
     o.x = x + 2e-6 * normal(rng);
+    if (report_temp) o.temp = temp + 0.05 * normal(rng);
+    if (report_supply) o.ps = now.ps + 5e3 * normal(rng);
     // Command whose load flow (valve_flow.hpp) feeds the leak, the null leak and the motion.
-    const double flow = (leak_now + null_leak) * dp + area * (x - previous_x) / hop;
+    const double flow = (leak_now + null_leak * r) * dp + area * (x - previous_x) / hop;
     const double per_opening = std::abs(detect::load_flow_per_kv(
-        valve, std::copysign(valve.u_max, flow), p_mid + dp / 2, p_mid - dp / 2));
+        now, std::copysign(now.u_max, flow), p_mid + dp / 2, p_mid - dp / 2));
     const double opening = flow / (kv * per_opening);
     const bool arrived_across = x == target && previous_x != x && previous_x * x < 0.0;
     if (arrived_across) crossing_left = crossing_hops;

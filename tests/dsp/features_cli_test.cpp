@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "capture/capture.hpp"
 #include "dsp/streaming_features.hpp"
-#include "io/capture/capture.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon {
@@ -45,12 +45,12 @@ std::vector<double> write_capture(const std::string& path, std::size_t rows,
                                   const std::vector<std::size_t>& gaps) {
   std::mt19937_64 rng(17);
   std::normal_distribution<double> noise(0.0, 2e4);
-  io::CaptureWriter writer(path, {"t", "x", "p1", "extra"}, {{"sample_rate_hz", "500"}});
+  capture::CaptureWriter writer(path, {"t", "x", "p1", "extra"}, {{"sample_rate_hz", "500"}});
   std::vector<double> p1(rows);
   for (std::size_t i = 0; i < rows; ++i) {
     p1[i] = 8.65e6 + 1e5 * std::sin(0.05 * static_cast<double>(i)) + noise(rng);
     for (std::size_t g : gaps) {
-      if (g == i) p1[i] = io::kGap;
+      if (g == i) p1[i] = capture::kGap;
     }
     const double row[] = {static_cast<double>(i) * 0.002, 0.01, p1[i], 1.0};
     writer.write_row(row);

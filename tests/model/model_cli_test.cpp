@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "model/synthetic_case.hpp"
 #include "tests/model/test_seed.hpp"
 #include "tests/support/paths.hpp"
@@ -33,7 +33,7 @@ TEST(ModelCli, ChecksACaptureAndWritesJsonAndReport) {
   const auto seed = test::model_test_seed("ModelCli.ChecksACaptureAndWritesJsonAndReport");
   const std::string dir = test::scratch_dir("model_cli_check");
   const SyntheticCase c = draw_case(seed, "internal_leakage", {40.0});
-  io::write_capture(dir + "/capture.csv", simulate_case(c));
+  capture::write_capture(dir + "/capture.csv", simulate_case(c));
   ASSERT_EQ(run("model check --data " + dir + "/capture.csv --json " + dir +
                     "/result.json --report " + dir + "/report",
                 dir + "/log.txt"),

@@ -53,7 +53,7 @@ TEST(SpectralLine, CleanCaptureHasNoSignificantLine) {
 TEST(SpectralLine, UsesTheSupplyPressureColumnWhenPresent) {
   const auto seed = test::model_test_seed("SpectralLine.UsesTheSupplyPressureColumnWhenPresent");
   const SyntheticCase c = draw_case(seed, "none", {kDuration});
-  io::Capture capture = simulate_case(c);
+  capture::Capture capture = simulate_case(c);
   // A supply transducer reading a 2e5 Pa, 47.3 Hz ripple with the chamber transducers' noise;
   // the chambers themselves carry none (a ripple upstream of a filter, say).
   std::mt19937_64 engine(seed);

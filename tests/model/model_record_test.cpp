@@ -4,7 +4,7 @@
 #include <fstream>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "model/measured_record.hpp"
 #include "tests/support/paths.hpp"
 
@@ -81,7 +81,7 @@ TEST(ModelRecord, MalformedValuesAreCaptureErrorsWithLineAndColumn) {
   std::ofstream out(path);
   out << "t,u,x,p1,p2\n0,0,0,1,1\n0.002,0,abc,1,1\n";
   out.close();
-  EXPECT_THROW(read_measured_record(path), io::CaptureError);
+  EXPECT_THROW(read_measured_record(path), capture::CaptureError);
   const std::string error = error_of(path);
   EXPECT_NE(error.find(":3"), std::string::npos) << error;
 }

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/paths.hpp"

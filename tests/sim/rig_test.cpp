@@ -98,7 +98,7 @@ TEST(RigStep, LeakCanBeInjectedAndHealedAtRunTime) {
 TEST(BatchSimulation, WritesTheCaptureColumnsAndMetadata) {
   Scenario s = everything_on();
   s.params.beta = 6e8;
-  const io::Capture capture = simulate(s);
+  const capture::Capture capture = simulate(s);
   EXPECT_EQ(capture.columns,
             (std::vector<std::string>{"t", "xref", "u", "x", "p1", "p2", "q_int"}));
   EXPECT_EQ(capture.rows(), 2000u);

@@ -2,6 +2,7 @@
 // with file:line:column and the field's path; presets carry MODEL.md's experiment table.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -31,7 +32,7 @@ TEST(ScenarioFiles, EveryExampleLoadsAndRuns) {
     EXPECT_FALSE(s.name.empty());
     EXPECT_NE(s.origin.find(entry.path().filename().string()), std::string::npos);
     s.duration_s = 1.0;
-    const io::Capture capture = simulate(s);
+    const capture::Capture capture = simulate(s);
     EXPECT_EQ(capture.rows(), 500u) << entry.path();
     ++count;
   }
@@ -121,6 +122,124 @@ TEST(ScenarioErrors, NameFileLineColumnAndField) {
   // Reference ranges the wrong way round.
   e = error_of("reference: {amp_min: 0.05, amp_max: 0.02}\n");
   EXPECT_NE(e.find("amp_max"), std::string::npos) << e;
+}
+
+TEST(ScenarioFiles, ReadConditionsFaultsAndRecordedColumns) {
+  const Scenario s = parse_scenario(R"(name: drift
+effects:
+  external_leakage: {C_E: 4.0e-13, chamber: 1, onset_s: 30, ramp_s: 2}
+conditions:
+  oil: {grade: 68}
+  temperature: {profile: warm_up_cooler, T0: 18, T_work: 52, tau_s: 300, start_s: 10,
+                amplitude: 3, period_s: 400}
+  supply:
+    - {t_s: 120, ps: 1.4e7, ramp_s: 2}
+    - {t_s: 200, ps: 1.8e7}
+record: [ps, temp]
+sensors: {temp_resolution: 0.05, temp_noise_sigma: 0.02}
+faults:
+  - {type: frozen, channel: p1, start_s: 20, duration_s: 10}
+  - {type: saturated, channel: ps, start_s: 40, level: low}
+  - {type: spikes, channel: temp, start_s: 0, rate_per_min: 6, magnitude: 15}
+  - {type: dropout, channel: x, start_s: 50, duration_s: 2, mode: gap}
+)",
+                                    "drift.yaml");
+  EXPECT_EQ(s.conditions.oil.name(), "ISO VG 68");
+  ASSERT_TRUE(s.conditions.temperature);
+  const TemperatureProfile& t = *s.conditions.temperature;
+  EXPECT_EQ(t.kind, TemperatureProfile::Kind::warm_up_cooler);
+  EXPECT_EQ(t.T0, 18.0);
+  EXPECT_EQ(t.T_work, 52.0);
+  EXPECT_EQ(t.tau_s, 300.0);
+  EXPECT_EQ(t.start_s, 10.0);
+  EXPECT_EQ(t.amplitude, 3.0);
+  EXPECT_EQ(t.period_s, 400.0);
+  EXPECT_EQ(t.cooler_start_s, 910.0);  // default: start_s + 3 tau_s
+  ASSERT_EQ(s.conditions.supply.size(), 2u);
+  EXPECT_EQ(s.conditions.supply[0].ramp_s, 2.0);
+  EXPECT_EQ(s.conditions.supply[1].ps, 1.8e7);
+  EXPECT_EQ(s.conditions.supply[1].ramp_s, 0.0);
+  EXPECT_TRUE(s.record.ps);
+  EXPECT_TRUE(s.record.temp);
+  EXPECT_EQ(s.sensors.temp_resolution, 0.05);
+  EXPECT_EQ(s.sensors.temp_noise_sigma, 0.02);
+  ASSERT_EQ(s.faults.size(), 4u);
+  EXPECT_EQ(s.faults[0].kind, SensorFault::Kind::frozen);
+  EXPECT_EQ(s.faults[0].duration_s, 10.0);
+  EXPECT_EQ(s.faults[1].channel, SensorChannel::ps);
+  EXPECT_FALSE(s.faults[1].high);
+  EXPECT_TRUE(std::isinf(s.faults[1].duration_s));
+  EXPECT_EQ(s.faults[2].rate_per_min, 6.0);
+  EXPECT_EQ(s.faults[2].magnitude, 15.0);
+  EXPECT_TRUE(s.faults[3].gap);
+  ASSERT_TRUE(s.effects.external_leakage);
+  EXPECT_EQ(s.effects.external_leakage->onset_s, 30.0);
+  EXPECT_EQ(s.effects.external_leakage->ramp_s, 2.0);
+  // Drifting conditions keep the automatic step.
+  EXPECT_EQ(integration_step(s), 2.5e-4);
+
+  const Scenario custom = parse_scenario(
+      "conditions:\n  oil: {nu40: 40, nu100: 6}\n  temperature: {profile: constant, T: 33}\n",
+      "custom.yaml");
+  EXPECT_EQ(custom.conditions.oil.nu40(), 40.0);
+  EXPECT_EQ(custom.conditions.temperature->at(100.0), 33.0);
+  EXPECT_FALSE(custom.record.temp);
+}
+
+TEST(ScenarioErrors, ConditionsAndFaultsNameFileLineColumn) {
+  // A key the chosen profile does not take.
+  std::string e =
+      error_of("conditions:\n  temperature: {profile: cooler, T_work: 45, tau_s: 300}\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("tau_s"), std::string::npos) << e;
+  // Unknown profile.
+  e = error_of("conditions:\n  temperature:\n    profile: sauna\n");
+  EXPECT_NE(e.find("bad.yaml:3:14"), std::string::npos) << e;
+  EXPECT_NE(e.find("warm_up_cooler"), std::string::npos) << e;
+  // Temperature out of range.
+  e = error_of("conditions:\n  temperature: {profile: constant, T: 400}\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("T"), std::string::npos) << e;
+  // Unknown oil grade.
+  e = error_of("conditions:\n  oil: {grade: 50}\n");
+  EXPECT_NE(e.find("bad.yaml:2:16"), std::string::npos) << e;
+  EXPECT_NE(e.find("32, 46 or 68"), std::string::npos) << e;
+  // Data-sheet viscosities the wrong way round.
+  e = error_of("conditions:\n  oil: {nu40: 6, nu100: 40}\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("nu100"), std::string::npos) << e;
+  // Overlapping supply changes.
+  e = error_of(
+      "conditions:\n  supply:\n    - {t_s: 10, ps: 1.4e7, ramp_s: 5}\n    - {t_s: 12, ps: "
+      "1.6e7}\n");
+  EXPECT_NE(e.find("bad.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("overlap"), std::string::npos) << e;
+  // Supply out of range.
+  e = error_of("conditions:\n  supply: [{t_s: 10, ps: -3}]\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("ps"), std::string::npos) << e;
+  // A fault on a channel that is not recorded.
+  e = error_of("faults:\n  - {type: frozen, channel: temp, start_s: 3}\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("record"), std::string::npos) << e;
+  // Unknown fault type, unknown channel, a key of another fault type.
+  e = error_of("faults:\n  - {type: melted, channel: p1}\n");
+  EXPECT_NE(e.find("bad.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("dropout"), std::string::npos) << e;
+  e = error_of("faults:\n  - {type: frozen, channel: p3}\n");
+  EXPECT_NE(e.find("p3"), std::string::npos) << e;
+  e = error_of("faults:\n  - type: frozen\n    channel: p1\n    mode: gap\n");
+  EXPECT_NE(e.find("bad.yaml:4:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("mode"), std::string::npos) << e;
+  e = error_of("faults:\n  - {type: dropout, channel: p1, mode: nan}\n");
+  EXPECT_NE(e.find("gap"), std::string::npos) << e;
+  // Unknown optional column.
+  e = error_of("record: [ps, flow]\n");
+  EXPECT_NE(e.find("bad.yaml:1:14"), std::string::npos) << e;
+  EXPECT_NE(e.find("flow"), std::string::npos) << e;
+  // External leak onset out of range.
+  e = error_of("effects:\n  external_leakage: {C_E: 1.0e-12, onset_s: -4}\n");
+  EXPECT_NE(e.find("onset_s"), std::string::npos) << e;
 }
 
 TEST(ScenarioErrors, MissingFileIsAConfigError) {

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon {
@@ -32,7 +32,7 @@ TEST(SimCommand, PresetWritesTheCaptureWithMetadata) {
   const std::string dir = test::scratch_dir("sim_command_preset");
   const Result r = run("--preset paper-fig10 --seed 7 --duration 2 --out " + dir + "/fig10.csv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const io::Capture capture = io::read_capture(dir + "/fig10.csv");
+  const capture::Capture capture = capture::read_capture(dir + "/fig10.csv");
   for (const char* column : {"t", "xref", "u", "x", "p1", "p2", "q_int"}) {
     EXPECT_TRUE(capture.has(column)) << column;
   }
@@ -49,7 +49,7 @@ TEST(SimCommand, ScenarioFileRunsAndBadFilesFailWithTheirLocation) {
       run("--scenario " + test::source_dir() +
           "/sim/scenarios/supply-disturbances.yaml --duration 1 --out " + dir + "/s.csv");
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
-  const io::Capture capture = io::read_capture(dir + "/s.csv");
+  const capture::Capture capture = capture::read_capture(dir + "/s.csv");
   EXPECT_EQ(capture.rows(), 500u);
   int effects = 0;
   for (const auto& [key, value] : capture.metadata) effects += key == "effect";
@@ -61,6 +61,36 @@ TEST(SimCommand, ScenarioFileRunsAndBadFilesFailWithTheirLocation) {
   EXPECT_EQ(failed.exit_code, 1);
   EXPECT_NE(failed.output.find(bad + ":3:"), std::string::npos) << failed.output;
   EXPECT_NE(failed.output.find("f"), std::string::npos) << failed.output;
+}
+
+TEST(SimCommand, DriftingConditionsAndFaultsReachTheCapture) {
+  const std::string dir = test::scratch_dir("sim_command_drift");
+  const Result ok = run("--scenario " + test::source_dir() +
+                        "/sim/scenarios/sensor-faults.yaml --duration 100 --out " + dir + "/f.csv");
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const capture::Capture capture = capture::read_capture(dir + "/f.csv");
+  ASSERT_TRUE(capture.has("temp"));
+  ASSERT_TRUE(capture.has("ps"));
+  EXPECT_EQ(capture.metadata_value("temperature"), "constant T=45");
+  int faults = 0;
+  for (const auto& [key, value] : capture.metadata) faults += key == "sensor_fault";
+  EXPECT_EQ(faults, 6);
+  // p1 frozen from 40 s to 60 s: one value repeated exactly; p2 at full scale from 90 s.
+  const auto& p1 = capture.column("p1");
+  for (std::size_t k = 20000; k < 30000; ++k) ASSERT_EQ(p1[k], p1[19999]) << k;
+  EXPECT_EQ(capture.column("p2")[46000], 20.7e6);
+  EXPECT_NEAR(capture.column("temp")[100], 45.0, 0.3);
+
+  // --record adds the optional columns to a preset.
+  const Result recorded =
+      run("--preset healthy --duration 1 --record temp,ps --out " + dir + "/r.csv");
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  const capture::Capture r = capture::read_capture(dir + "/r.csv");
+  EXPECT_EQ(r.columns,
+            (std::vector<std::string>{"t", "xref", "u", "x", "p1", "p2", "q_int", "ps", "temp"}));
+  EXPECT_NEAR(r.column("temp")[0], 40.0, 0.3);
+  EXPECT_NEAR(r.column("ps")[0], 17.2e6, 3e4);
+  EXPECT_EQ(run("--preset healthy --record flow --out /tmp/x.csv").exit_code, 2);
 }
 
 TEST(SimCommand, UsageErrorsExitWithTwo) {

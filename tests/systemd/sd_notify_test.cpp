@@ -7,7 +7,7 @@
 
 #include <set>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/daemon/daemon_process.hpp"
 
 namespace leakmon {
@@ -54,7 +54,7 @@ class NotifySocket {
 
 TEST(SdNotify, ReadyWatchdogReloadingStopping) {
   const std::string dir = test::scratch_dir("sd_notify");
-  io::Capture capture;
+  capture::Capture capture;
   capture.columns = {"t", "p1", "p2"};
   capture.values.assign(3, {});
   for (int i = 0; i < 2000; ++i) {
@@ -62,7 +62,7 @@ TEST(SdNotify, ReadyWatchdogReloadingStopping) {
     capture.values[1].push_back(8e6 + (i % 7) * 1e3);
     capture.values[2].push_back(8e6 - (i % 5) * 1e3);
   }
-  io::write_capture(dir + "/c.csv", capture);
+  capture::write_capture(dir + "/c.csv", capture);
   std::ofstream(dir + "/leakmon.yaml")
       << "drivers: [{name: bench, type: replay, path: c.csv, loop: true}]\n"
          "actuators: [{name: a, channels: {p1: p1, p2: p2}}]\n"

@@ -205,18 +205,18 @@ int main() {
   // 5. Error frames become health, never values.
   run({"cansend", "vcan0", "20000040#0000000000000000"});  // CAN_ERR_BUSOFF
   reader.read();
-  check(driver.health().state == "bus-off" && driver.counters().bus_off == 1,
-        "bus-off error frame -> state '" + driver.health().state + "', last error '" +
+  check(driver.health().detail == "bus-off" && driver.counters().bus_off == 1,
+        "bus-off error frame -> state '" + driver.health().detail + "', last error '" +
             driver.health().last_error + "'");
   check(reader.values[0] == 1500000.0, "values unaffected by the error frame");
   run({"cansend", "vcan0", "20000100#0000000000000000"});  // CAN_ERR_RESTARTED
   reader.read();
-  check(driver.health().state == "ok",
-        "controller restarted -> state '" + driver.health().state + "'");
+  check(driver.health().detail == "ok",
+        "controller restarted -> state '" + driver.health().detail + "'");
   run({"cansend", "vcan0", "20000004#0020000000000000"});  // CAN_ERR_CRTL, TX passive
   reader.read();
-  check(driver.health().state == "error-passive",
-        "controller error-passive -> state '" + driver.health().state + "'");
+  check(driver.health().detail == "error-passive",
+        "controller error-passive -> state '" + driver.health().detail + "'");
   run({"cansend", "vcan0", "20000004#0040000000000000"});  // CAN_ERR_CRTL_ACTIVE
   reader.read();
 
@@ -246,8 +246,8 @@ int main() {
   // 7. Interface down: the socket reports it, values age into gaps, and come back after up.
   run({"ip", "link", "set", "vcan0", "down"});
   reader.read();
-  check(driver.health().state == "interface-down",
-        "link down -> state '" + driver.health().state + "'");
+  check(driver.health().detail == "interface-down",
+        "link down -> state '" + driver.health().detail + "'");
   sleep_ms(300);
   short_reader.read();
   check(std::isnan(short_reader.values[0]),
@@ -255,8 +255,8 @@ int main() {
   run({"ip", "link", "set", "vcan0", "up"});
   run({"cansend", "vcan0", "101#01000200"});
   reader.read();
-  check(driver.health().state == "ok" && reader.values[0] == 500.0,
-        "link up again -> state '" + driver.health().state + "', p1 " + show(reader.values[0]));
+  check(driver.health().detail == "ok" && reader.values[0] == 500.0,
+        "link up again -> state '" + driver.health().detail + "', p1 " + show(reader.values[0]));
 
   // 8. The real-time path allocated nothing in all of the above.
   check(reader.allocations_in_read == 0,

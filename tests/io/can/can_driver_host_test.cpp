@@ -31,6 +31,15 @@ bool host_has_can() {
   return true;
 }
 
+// The controller's fault-confinement states as NAMUR NE 107 categories: frames still arrive
+// while error-warning or error-passive (degrading), none when bus-off.
+TEST(CanDriverHost, BusStatesMapOntoNe107) {
+  EXPECT_EQ(can::device_status(can::BusState::active), DeviceStatus::ok);
+  EXPECT_EQ(can::device_status(can::BusState::warning), DeviceStatus::maintenance_required);
+  EXPECT_EQ(can::device_status(can::BusState::passive), DeviceStatus::maintenance_required);
+  EXPECT_EQ(can::device_status(can::BusState::bus_off), DeviceStatus::failure);
+}
+
 TEST(CanDriverHost, ReadBeforeStartGivesGapsWithoutAllocating) {
   auto driver = vcan_driver("vcan0");
   std::vector<double> values(1, 0.0);
@@ -55,7 +64,8 @@ TEST(CanDriverHost, StartFailsWithAClearErrorWhenTheSocketCannotBeHad) {
       EXPECT_NE(message.find("no such interface"), std::string::npos) << message;
     }
   }
-  EXPECT_EQ(driver->health().state, "ok") << "a failed start is not a bus state";
+  EXPECT_EQ(driver->health().detail, "ok") << "a failed start is not a bus state";
+  EXPECT_EQ(driver->health().status, DeviceStatus::ok);
 }
 
 }  // namespace

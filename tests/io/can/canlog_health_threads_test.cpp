@@ -48,7 +48,8 @@ TEST(CanlogHealthThreads, HealthIsSafeToReadWhileReplaying) {
   done = true;
   metrics.join();
   EXPECT_EQ(driver->health().errors, 6000U) << "3000 error frames and 3000 short frames";
-  EXPECT_EQ(driver->health().state, "bus-off");
+  EXPECT_EQ(driver->health().detail, "bus-off");
+  EXPECT_EQ(driver->health().status, DeviceStatus::failure);
 }
 
 }  // namespace

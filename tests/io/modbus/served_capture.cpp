@@ -6,7 +6,7 @@
 #include <cmath>
 #include <thread>
 
-#include "io/capture/capture.hpp"
+#include "capture/capture.hpp"
 #include "tests/support/alloc_counter.hpp"
 
 namespace leakmon::test {
@@ -25,8 +25,8 @@ std::int64_t monotonic_ns() {
 }
 
 ServedCapture::ServedCapture(const std::string& dir, int rows) : path_(dir + "/served.csv") {
-  io::CaptureWriter writer(path_, {"t", "p1", "p2", "x", "u", "valve"},
-                           {{"sample_rate_hz", "500"}, {"source", "modbus driver test"}});
+  capture::CaptureWriter writer(path_, {"t", "p1", "p2", "x", "u", "valve"},
+                                {{"sample_rate_hz", "500"}, {"source", "modbus driver test"}});
   for (int i = 0; i < rows; ++i) {
     const double t = i / kRate;
     const double p1 = 8.65e6 + 2.0e5 * std::sin(2 * M_PI * 1.3 * t) + 1.0e4 * std::sin(97.0 * t);

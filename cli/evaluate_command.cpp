@@ -1,0 +1,160 @@
+// `leakmon evaluate`: Monte-Carlo error rates of the leak detectors. Draws rigs across MODEL.md's
+// calibration spread (both controllers, spring 40-120 kN/m, beta, Kv, m, b, reference
+// amplitudes and seeds), healthy runs and runs with a leak switched on mid-run, simulates each
+// (sim/) and replays it in process through exactly the daemon's pipeline
+// (daemon::replay_capture). Every detector under test is one actuator of the replayed
+// configuration, at several alarm thresholds, so one replay yields the whole ROC sweep. Writes
+// runs.json (every run and alarm), summary.json, summary.tsv and summary.md into --out, and the
+// plots when --plots is given (docs/tools/detection_plots.py). The harness is study/ (case
+// generation, runner, aggregation, writers); this front end parses the options and calls it.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
+#include "sim/effects.hpp"
+#include "study/case_generation.hpp"
+#include "study/evaluation_options.hpp"
+#include "study/evaluation_runner.hpp"
+#include "study/evaluation_writers.hpp"
+
+namespace leakmon::cli {
+
+namespace {
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+std::vector<double> parse_list(const std::string& option, const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      values.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      throw UsageError(fmt::format("option '--{}': '{}' is not a number", option, item));
+    }
+  }
+  return values;
+}
+
+}  // namespace
+
+int run_evaluate(int argc, char** argv) {
+  ArgParser args("evaluate",
+                 "Monte-Carlo error rates of the leak detectors on simulated rigs, each capture\n"
+                 "replayed through the daemon's pipeline. Writes runs.json, summary.json,\n"
+                 "summary.tsv and summary.md into --out (and plots with --plots).");
+  args.option("out", "DIR", "output directory", std::nullopt, true)
+      .option("healthy-runs", "N", "healthy runs (false-alarm rate)", "8")
+      .option("healthy-seconds", "S", "length of each healthy run", "900")
+      .option("runs-per-leak", "N", "runs per leak size", "6")
+      .option("leaks", "LIST", "leak sizes C_L [m^3/(s Pa)], comma-separated",
+              "1e-13,2.5e-13,5e-13,1e-12,2e-12,5e-12")
+      .option("learn-seconds", "S", "each detector's learning period", "90")
+      .option("after-onset", "S", "run length after the leak onset", "90")
+      .option("seed", "N", "master seed", "1")
+      .option("jobs", "N", "parallel runs", "2")
+      .option("effects", "LIST",
+              "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
+      .option("conditions", "LIST",
+              "operating conditions the runs cycle through, comma-separated: stationary, warmup, "
+              "cooler, supply, sensor-faults (MODEL.md drifting conditions and sensor faults); "
+              "adds conditions.md and conditions.tsv",
+              "stationary")
+      .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
+              "")
+      .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
+      .option("plot-script", "PATH", "the plotting script", "docs/tools/detection_plots.py");
+  if (!args.parse(argc, argv)) return 0;
+
+  study::EvaluationOptions settings;
+  settings.healthy_runs = static_cast<int>(args.get_int("healthy-runs"));
+  settings.healthy_seconds = args.get_double("healthy-seconds");
+  settings.runs_per_leak = static_cast<int>(args.get_int("runs-per-leak"));
+  settings.leak_sizes = parse_list("leaks", args.get("leaks"));
+  settings.learn_seconds = args.get_double("learn-seconds");
+  settings.after_onset_seconds = args.get_double("after-onset");
+  settings.seed = static_cast<std::uint64_t>(args.get_int("seed"));
+  settings.jobs = static_cast<int>(args.get_int("jobs"));
+  settings.effects = split(args.get("effects"));
+  for (const auto& effect : settings.effects) {
+    try {
+      sim::Effects().enable(effect);
+    } catch (const std::exception& e) {
+      throw UsageError(fmt::format("option '--effects': {}", e.what()));
+    }
+  }
+  settings.conditions = split(args.get("conditions"));
+  for (const auto& condition : settings.conditions) {
+    if (!study::is_condition(condition)) {
+      throw UsageError(fmt::format(
+          "option '--conditions': unknown condition '{}' (known: stationary, warmup, cooler, "
+          "supply, sensor-faults)",
+          condition));
+    }
+  }
+  if (settings.conditions.empty()) settings.conditions = {"stationary"};
+  if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.jobs < 1) {
+    throw UsageError("run counts must be >= 0 and --jobs >= 1");
+  }
+  if (settings.learn_seconds < 1 || settings.healthy_seconds < settings.learn_seconds + 10 ||
+      settings.after_onset_seconds < settings.detect_within) {
+    throw UsageError(
+        "need --learn-seconds >= 1, --healthy-seconds >= learn + 10, --after-onset >= 60");
+  }
+  for (double id : parse_list("keep-captures", args.get("keep-captures"))) {
+    settings.keep_captures.push_back(static_cast<int>(id));
+  }
+  const std::filesystem::path out = args.get("out");
+  settings.out = out;
+  std::filesystem::create_directories(out);
+
+  const std::vector<study::RunSpec> runs = study::draw_runs(settings);
+  std::vector<study::RunResult> results;
+  try {
+    results = study::run_evaluation(runs, settings, [](std::size_t done, std::size_t total) {
+      fmt::print(stderr, "\r[{}/{}] runs evaluated", done, total);
+      std::fflush(stderr);
+    });
+  } catch (...) {
+    fmt::print(stderr, "\n");
+    throw;
+  }
+  fmt::print(stderr, "\n");
+
+  study::write_runs_json(out / "runs.json", results);
+  study::write_summaries(out, settings, results);
+  study::write_condition_summaries(out, settings, results);
+  fmt::print(
+      "wrote {}/runs.json, summary.json, summary.tsv, summary.md, size_coverage.tsv, "
+      "conditions.md, conditions.tsv\n",
+      out.string());
+
+  if (args.flag_set("plots")) {
+    const std::string command =
+        fmt::format("/usr/bin/python3 '{}' '{}'", args.get("plot-script"), out.string());
+    if (std::system(command.c_str()) != 0) {
+      throw std::runtime_error("plotting failed: " + command);
+    }
+  }
+  return 0;
+}
+
+}  // namespace leakmon::cli

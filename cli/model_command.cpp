@@ -1,0 +1,110 @@
+// `leakmon model check` and `leakmon model evaluate` (FORMATS.md, issue 7): where the rig
+// simulation disagrees with measured data, which effect of MODEL.md's library explains it,
+// and how well the workflow does on cases drawn afresh from MODEL.md.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
+#include "model/diagnosis.hpp"
+#include "model/effect_library.hpp"
+#include "model/evaluation.hpp"
+#include "model/measured_record.hpp"
+#include "model/report.hpp"
+#include "model/result_json.hpp"
+
+namespace leakmon::cli {
+namespace {
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw std::runtime_error(fmt::format("{}: cannot write", path));
+}
+
+int run_check(int argc, char** argv) {
+  ArgParser args("model check",
+                 "Calibrates beta, Kv, m, b on the fitting part of a capture, extends the model\n"
+                 "with each effect of MODEL.md's library, scores each on held-out data and names\n"
+                 "the best when its gain is significant (else `none`). Writes FORMATS.md's JSON.");
+  args.option("data", "CAPTURE.csv", "capture with at least t,u,x,p1,p2 at 500 Hz", std::nullopt,
+              true)
+      .option("json", "RESULT.json", "where to write the result", std::nullopt, true)
+      .option("report", "DIR", "also write a Markdown report with plots into DIR", "");
+  if (!args.parse(argc, argv, 2)) return 0;
+  const model::MeasuredRecord record = model::read_measured_record(args.get("data"));
+  const model::Diagnosis d = model::diagnose(record);
+  write_text(args.get("json"), model::diagnosis_json(d));
+  fmt::print("cause: {} (held-out NRMSE {:.4f} -> {:.4f})\n", d.cause, d.nrmse_before,
+             d.nrmse_after);
+  if (const auto dir = args.get("report"); !dir.empty()) {
+    if (!model::write_report(dir, record, d)) {
+      fmt::print(stderr, "leakmon model check: plots failed, see {}/plots.log\n", dir);
+    }
+    fmt::print("report: {}/report.md\n", dir);
+  }
+  return 0;
+}
+
+int run_evaluate_cases(int argc, char** argv) {
+  ArgParser args("model evaluate",
+                 "Draws cases afresh from MODEL.md (each effect of the library and none in turn,\n"
+                 "parameters, calibration, controller and reference at random), simulates them\n"
+                 "with sensor and spool noise and runs the model check on each. Writes\n"
+                 "OUT/cases.csv and OUT/summary.md (accuracy and confusion matrix).");
+  args.option("cases", "N", "number of cases", "24")
+      .option("seed", "S", "seed of the first case; case i uses S + i", "1")
+      .option("duration", "SECONDS", "length of each simulated capture", "60")
+      .option("out", "DIR", "output directory", std::nullopt, true);
+  if (!args.parse(argc, argv, 2)) return 0;
+  const long long cases = args.get_int("cases");
+  if (cases < 1) throw UsageError("option '--cases': must be at least 1");
+  const auto first = static_cast<std::uint64_t>(args.get_int("seed"));
+  model::CaseSettings case_settings;
+  case_settings.duration_s = args.get_double("duration");
+  std::vector<std::string> effects = model::effect_names();
+  effects.push_back("none");
+  model::EvaluationSummary summary;
+  for (long long i = 0; i < cases; ++i) {
+    const auto& effect = effects[static_cast<std::size_t>(i) % effects.size()];
+    const auto seed = first + static_cast<std::uint64_t>(i);
+    summary.cases.push_back(model::evaluate_case(seed, effect, case_settings));
+    const auto& c = summary.cases.back();
+    fmt::print(
+        "case {} seed {}: {} -> {} ({} true {:.4g} est {:.4g}) nrmse {:.4f} -> {:.4f} "
+        "{:.1f} s; leading {} score {:.4f} t {:.2f}; line z {:.2f}\n",
+        i, seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
+        c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z);
+    std::fflush(stdout);
+  }
+  const std::string dir = args.get("out");
+  std::filesystem::create_directories(dir);
+  write_text(dir + "/cases.csv", summary.csv());
+  write_text(dir + "/summary.md", summary.markdown());
+  fmt::print("{}", summary.markdown());
+  return 0;
+}
+
+}  // namespace
+
+int run_model(int argc, char** argv) {
+  const std::string_view usage =
+      "usage: leakmon model check --data CAPTURE.csv --json RESULT.json [--report DIR]\n"
+      "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n";
+  if (argc < 2) throw UsageError(std::string(usage));
+  const std::string_view action = argv[1];
+  if (action == "-h" || action == "--help") {
+    fmt::print("{}", usage);
+    return 0;
+  }
+  if (action == "check") return run_check(argc, argv);
+  if (action == "evaluate") return run_evaluate_cases(argc, argv);
+  throw UsageError(fmt::format("unknown action '{}'\n{}", action, usage));
+}
+
+}  // namespace leakmon::cli

@@ -1,0 +1,58 @@
+// `leakmon status` and `leakmon ack`: talk to a running daemon over its metrics endpoint.
+#include <fmt/format.h>
+
+#include "cli/args.hpp"
+#include "cli/subcommands.hpp"
+#include "daemon/config.hpp"
+#include "daemon/http_endpoint.hpp"
+
+namespace leakmon::cli {
+namespace {
+
+void endpoint_options(ArgParser& args) {
+  args.option("config", "CONFIG.yaml", "take address and port from the daemon's configuration",
+              std::string("/etc/leakmon/leakmon.yaml"));
+  args.option("port", "N", "metrics port (overrides --config)", std::string(""));
+  args.option("address", "IP", "metrics address", std::string(""));
+}
+
+std::pair<std::string, int> endpoint(const ArgParser& args) {
+  daemon::MetricsConfig metrics;
+  if (args.get("port").empty()) {
+    metrics = daemon::load_config(args.get("config")).metrics;
+    if (metrics.port == 0) {
+      throw UsageError(
+          fmt::format("{} disables the metrics endpoint (metrics.port: 0)", args.get("config")));
+    }
+  } else {
+    metrics.port = static_cast<int>(args.get_int("port"));
+  }
+  if (!args.get("address").empty()) metrics.address = args.get("address");
+  return {metrics.address, metrics.port};
+}
+
+}  // namespace
+
+int run_status(int argc, char** argv) {
+  ArgParser args("status", "print a summary from the running daemon");
+  endpoint_options(args);
+  if (!args.parse(argc, argv)) return 0;
+  const auto [address, port] = endpoint(args);
+  const auto response = daemon::http_request(address, port, "GET", "/status");
+  fmt::print("{}", response.body);
+  return response.status == 200 ? 0 : 1;
+}
+
+int run_ack(int argc, char** argv) {
+  ArgParser args("ack", "acknowledge alarms in the running daemon");
+  endpoint_options(args);
+  args.option("actuator", "NAME", "only this actuator's alarm (default: all)", std::string(""));
+  if (!args.parse(argc, argv)) return 0;
+  const auto [address, port] = endpoint(args);
+  const auto response =
+      daemon::http_request(address, port, "POST", "/ack?actuator=" + args.get("actuator"));
+  fmt::print("{}", response.body);
+  return response.status == 200 ? 0 : 1;
+}
+
+}  // namespace leakmon::cli

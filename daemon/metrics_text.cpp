@@ -1,0 +1,308 @@
+// The Prometheus writer, and the daemon's metrics and status texts built with it.
+#include "daemon/metrics_text.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "daemon/daemon.hpp"
+
+namespace leakmon::daemon {
+
+std::string escape_label_value(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+std::string metric_number(double value) {
+  return std::isfinite(value) ? fmt::format("{}", value) : "NaN";
+}
+
+std::string label(std::string_view name, std::string_view value) {
+  return fmt::format("{}=\"{}\"", name, escape_label_value(value));
+}
+
+void PrometheusText::family(std::string_view name, std::string_view help, std::string_view type) {
+  out_ += fmt::format("# HELP {} {}\n# TYPE {} {}\n", name, help, name, type);
+}
+
+void PrometheusText::sample(std::string_view name, std::string_view labels, std::uint64_t value) {
+  if (labels.empty()) {
+    out_ += fmt::format("{} {}\n", name, value);
+  } else {
+    out_ += fmt::format("{}{{{}}} {}\n", name, labels, value);
+  }
+}
+
+void PrometheusText::sample(std::string_view name, std::string_view labels, std::int64_t value) {
+  if (labels.empty()) {
+    out_ += fmt::format("{} {}\n", name, value);
+  } else {
+    out_ += fmt::format("{}{{{}}} {}\n", name, labels, value);
+  }
+}
+
+void PrometheusText::sample(std::string_view name, std::string_view labels, double value) {
+  if (labels.empty()) {
+    out_ += fmt::format("{} {}\n", name, metric_number(value));
+  } else {
+    out_ += fmt::format("{}{{{}}} {}\n", name, labels, metric_number(value));
+  }
+}
+
+void PrometheusText::histogram(std::string_view name, std::string_view labels,
+                               std::span<const double> upper_bounds,
+                               std::span<const std::uint64_t> cumulative, std::uint64_t count,
+                               double sum) {
+  if (upper_bounds.size() != cumulative.size()) {
+    throw std::invalid_argument(fmt::format("histogram {}: {} bounds but {} counts", name,
+                                            upper_bounds.size(), cumulative.size()));
+  }
+  const std::string_view sep = labels.empty() ? "" : ",";
+  for (std::size_t i = 0; i < upper_bounds.size(); ++i) {
+    out_ += fmt::format("{}_bucket{{{}{}le=\"{}\"}} {}\n", name, labels, sep, upper_bounds[i],
+                        cumulative[i]);
+  }
+  out_ += fmt::format("{}_bucket{{{}{}le=\"+Inf\"}} {}\n", name, labels, sep, count);
+  // An empty label set is still written as `{}` here, as the daemon always has.
+  out_ += fmt::format("{}_sum{{{}}} {}\n", name, labels, sum);
+  out_ += fmt::format("{}_count{{{}}} {}\n", name, labels, count);
+}
+
+namespace {
+
+void latency_histogram(PrometheusText& out, std::string_view name, std::string_view labels,
+                       const LatencyHistogram& h) {
+  static constexpr double kBucketsSeconds[] = {10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6,
+                                               1e-3,  2e-3,  5e-3,  10e-3,  20e-3};
+  std::uint64_t cumulative[std::size(kBucketsSeconds)];
+  for (std::size_t i = 0; i < std::size(kBucketsSeconds); ++i) {
+    cumulative[i] =
+        h.count_below(static_cast<std::int64_t>(std::llround(kBucketsSeconds[i] * 1e9)));
+  }
+  out.histogram(name, labels, kBucketsSeconds, cumulative, h.count(),
+                static_cast<double>(h.sum_ns()) / 1e9);
+}
+
+std::uint64_t flag(bool on) { return on ? 1 : 0; }
+
+}  // namespace
+
+std::string Daemon::metrics_text() const {
+  PrometheusText out;
+  out.family("leakmon_build_info", "leakmon version", "gauge");
+  out.sample("leakmon_build_info", label("version", LEAKMON_VERSION), std::uint64_t{1});
+
+  out.family("leakmon_loop_wakeup_latency_seconds", "acquisition loop wake-up minus schedule",
+             "histogram");
+  for (const auto& g : groups_) {
+    latency_histogram(out, "leakmon_loop_wakeup_latency_seconds", label("group", g->config.name),
+                      g->loop->counters().wakeup_latency);
+  }
+  auto per_group = [&](std::string_view name, std::string_view help, std::string_view type,
+                       auto value_of) {
+    out.family(name, help, type);
+    for (const auto& g : groups_) {
+      out.sample(name, label("group", g->config.name), static_cast<std::uint64_t>(value_of(*g)));
+    }
+  };
+  per_group("leakmon_loop_cycles_total", "acquisition cycles run", "counter",
+            [](const Group& g) { return g.loop->counters().cycles.load(); });
+  per_group("leakmon_loop_overruns_total", "late wake-ups that skipped a period", "counter",
+            [](const Group& g) { return g.loop->counters().overruns.load(); });
+  per_group("leakmon_loop_missed_cycles_total", "periods skipped by overruns", "counter",
+            [](const Group& g) { return g.loop->counters().missed_cycles.load(); });
+  per_group("leakmon_ring_drops_total", "samples dropped because the ring was full", "counter",
+            [](const Group& g) { return g.loop->counters().ring_drops.load(); });
+  per_group("leakmon_ring_high_water", "most samples ever queued in the ring", "gauge",
+            [](const Group& g) { return g.loop->counters().ring_high_water.load(); });
+  per_group("leakmon_ring_capacity", "ring capacity in samples", "gauge",
+            [](const Group& g) { return g.ring->capacity(); });
+  per_group("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
+            [](const Group& g) { return flag(g.realtime.fifo); });
+
+  out.family("leakmon_cpu_wakeup_latency_request_held",
+             "1 while the CPU wake-up latency request (/dev/cpu_dma_latency) is held", "gauge");
+  out.sample("leakmon_cpu_wakeup_latency_request_held", "", flag(cpu_latency_.held()));
+  out.family("leakmon_samples_processed_total", "samples the worker consumed", "counter");
+  out.sample("leakmon_samples_processed_total", "", worker_->samples_processed());
+  out.family("leakmon_events_total", "events published", "counter");
+  out.sample("leakmon_events_total", "", worker_->events_published());
+  out.family("leakmon_decision_latency_seconds", "sample acquisition to decision and events",
+             "histogram");
+  latency_histogram(out, "leakmon_decision_latency_seconds", "", worker_->decision_latency());
+
+  const auto actuators = worker_->status();
+  out.family("leakmon_index_pascal", "newest wavelet index (db8 level-2 detail RMS)", "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_index_pascal", label("actuator", a.name) + "," + label("channel", "p1"),
+               a.index_p1);
+    if (std::isfinite(a.index_p2)) {
+      out.sample("leakmon_index_pascal", label("actuator", a.name) + "," + label("channel", "p2"),
+                 a.index_p2);
+    }
+  }
+  out.family("leakmon_detector_score", "newest detector score", "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_detector_score",
+               label("actuator", a.name) + "," + label("detector", a.detector), a.score);
+  }
+  out.family("leakmon_detector_learning", "1 while the detector learns the healthy baseline",
+             "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_detector_learning", label("actuator", a.name), flag(a.learning));
+  }
+  out.family("leakmon_alarm_active", "1 while the alarm is annunciated", "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_alarm_active",
+               label("actuator", a.name) + "," + label("alarm", a.alarm) + "," +
+                   label("state", to_string(a.state)),
+               flag(a.state != AlarmState::normal));
+  }
+  // FORMATS.md "Operator view and fleet": the leak size in l/min/MPa (at 40 degC where the oil
+  // temperature is acquired), NaN until the detector has one; its 95 % half-width beside it.
+  constexpr double kLpmPerMpa = 60000.0 * 1e6;
+  out.family("leakmon_leak_lpm_per_mpa", "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel", "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_leak_lpm_per_mpa", label("actuator", a.name), a.leak_coefficient * kLpmPerMpa);
+  }
+  out.family("leakmon_leak_lpm_per_mpa_ci95", "95 % half-width of the leak size [l/min/MPa]", "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_leak_lpm_per_mpa_ci95", label("actuator", a.name),
+               a.leak_coefficient_ci * kLpmPerMpa);
+  }
+  out.family("leakmon_oil_temperature_celsius", "oil temperature (hop mean of the temp channel)", "gauge");
+  for (const auto& a : actuators) {
+    if (std::isfinite(a.oil_temperature)) {
+      out.sample("leakmon_oil_temperature_celsius", label("actuator", a.name), a.oil_temperature);
+    }
+  }
+  out.family("leakmon_sensor_status", "NAMUR NE 107 status of each transducer channel (1: current)",
+             "gauge");
+  for (const auto& a : actuators) {
+    for (const auto& c : a.channels) {
+      for (const io::DeviceStatus status :
+           {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
+            io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
+        out.sample("leakmon_sensor_status",
+                   label("actuator", a.name) + "," + label("channel", c.channel) + "," +
+                       label("status", io::to_string(status)),
+                   flag(c.status == status));
+      }
+    }
+  }
+  out.family("leakmon_sensor_spikes_rejected_total", "isolated spikes replaced before the index",
+             "counter");
+  for (const auto& a : actuators) {
+    for (const auto& c : a.channels) {
+      out.sample("leakmon_sensor_spikes_rejected_total",
+                 label("actuator", a.name) + "," + label("channel", c.channel), c.spikes_rejected);
+    }
+  }
+  out.family("leakmon_detector_suspended", "1 while a faulty channel holds the leak decision",
+             "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_detector_suspended", label("actuator", a.name), flag(a.suspended));
+  }
+
+  std::vector<io::DriverHealth> health;
+  for (const auto& d : drivers_) health.push_back(d->health());
+  out.family("leakmon_driver_errors_total", "driver communication errors", "counter");
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.sample("leakmon_driver_errors_total", label("driver", drivers_[i]->name()),
+               health[i].errors);
+  }
+  out.family("leakmon_driver_up", "1 when the driver reports NE 107 status ok", "gauge");
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.sample("leakmon_driver_up",
+               label("driver", drivers_[i]->name()) + "," + label("state", health[i].detail),
+               flag(health[i].status == io::DeviceStatus::ok));
+  }
+  // A state set: one series per NE 107 category, 1 for the driver's current one.
+  out.family("leakmon_driver_status", "driver health as NAMUR NE 107 category", "gauge");
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    for (const io::DeviceStatus status :
+         {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
+          io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
+      out.sample(
+          "leakmon_driver_status",
+          label("driver", drivers_[i]->name()) + "," + label("status", io::to_string(status)),
+          flag(health[i].status == status));
+    }
+  }
+  out.family("leakmon_driver_reconnects_total", "driver reconnects", "counter");
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.sample("leakmon_driver_reconnects_total", label("driver", drivers_[i]->name()),
+               health[i].reconnects);
+  }
+  out.family("leakmon_driver_stale_values_total",
+             "reads that gave a gap because the value was too old", "counter");
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.sample("leakmon_driver_stale_values_total", label("driver", drivers_[i]->name()),
+               health[i].stale_values);
+  }
+
+  out.family("leakmon_config_reload_success", "1 when the last reload (or start) succeeded",
+             "gauge");
+  out.sample("leakmon_config_reload_success", "", flag(last_reload_ok_.load()));
+  out.family("leakmon_config_reloads_total", "reloads applied", "counter");
+  out.sample("leakmon_config_reloads_total", "", reloads_.load());
+  out.family("leakmon_config_reload_failures_total", "reloads rejected", "counter");
+  out.sample("leakmon_config_reload_failures_total", "", reload_failures_.load());
+  out.family("leakmon_config_last_reload_timestamp_seconds", "unix time of the last reload attempt",
+             "gauge");
+  out.sample("leakmon_config_last_reload_timestamp_seconds", "", last_reload_unix_.load());
+  return out.take();
+}
+
+std::string Daemon::status_text() const {
+  std::string out =
+      fmt::format("leakmon {} running {:.0f} s, configuration {}\n", LEAKMON_VERSION,
+                  static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9, config_path_);
+  out += fmt::format("last reload: {}\n", last_reload_ok_.load() ? "ok" : "REJECTED (see log)");
+  for (const auto& g : groups_) {
+    const auto& c = g->loop->counters();
+    out += fmt::format(
+        "group {}: {} cycles, wake-up latency avg {:.1f} us max {:.1f} us, {} overruns, {} missed, "
+        "{} ring drops (high water {}/{}), {}\n",
+        g->config.name, c.cycles.load(), c.wakeup_latency.mean_ns() / 1e3,
+        static_cast<double>(c.wakeup_latency.max_ns()) / 1e3, c.overruns.load(),
+        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(), g->ring->capacity(),
+        g->realtime.fifo ? "SCHED_FIFO" : "normal scheduling");
+  }
+  for (const auto& d : drivers_) {
+    const auto health = d->health();
+    out += fmt::format("driver {}: {} (NE 107 {}){}{} ({} errors)\n", d->name(), health.detail,
+                       io::to_string(health.status), health.last_error.empty() ? "" : ": ",
+                       health.last_error, health.errors);
+  }
+  for (const auto& a : worker_->status()) {
+    out += fmt::format(
+        "actuator {}: alarm {} {}, index p1 {:.2f} kPa, score {:.3g}, baseline {:.2f} "
+        "kPa{}, detector {}, t {:.2f} s\n",
+        a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score, a.baseline / 1e3,
+        a.learning ? " (learning)" : "", a.detector, a.t);
+    if (std::isfinite(a.oil_temperature)) {
+      out += fmt::format("  oil temperature {:.1f} degC\n", a.oil_temperature);
+    }
+    for (const auto& c : a.channels) {
+      out += fmt::format("  channel {}: {}{}{}, {} spikes rejected\n", c.channel,
+                         io::to_string(c.status), c.fault == detect::SensorFault::none ? "" : " ",
+                         c.fault == detect::SensorFault::none ? "" : detect::to_string(c.fault),
+                         c.spikes_rejected);
+    }
+    if (a.suspended) out += "  leak decision suspended (sensor fault)\n";
+  }
+  return out;
+}
+
+}  // namespace leakmon::daemon

@@ -1,0 +1,90 @@
+// What the daemon tells the outside world: alarm transitions, driver faults, overruns, reloads.
+// The worker thread builds one Event per occurrence and hands it to every EventSink (JSON-lines
+// event log, spdlog, and the configured `outputs:` such as a Modbus coil). The sink is the
+// output plug-in point, beside the driver interface (io/driver.hpp); header-only, so that
+// outputs implement it without linking the daemon.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace leakmon::io {
+
+enum class EventKind {
+  alarm_raised,
+  alarm_cleared,
+  alarm_acknowledged,
+  driver_fault,
+  driver_recovered,
+  overrun,
+  config_reloaded,
+  config_rejected,
+};
+
+constexpr std::string_view to_string(EventKind kind) {
+  switch (kind) {
+    case EventKind::alarm_raised:
+      return "alarm_raised";
+    case EventKind::alarm_cleared:
+      return "alarm_cleared";
+    case EventKind::alarm_acknowledged:
+      return "alarm_acknowledged";
+    case EventKind::driver_fault:
+      return "driver_fault";
+    case EventKind::driver_recovered:
+      return "driver_recovered";
+    case EventKind::overrun:
+      return "overrun";
+    case EventKind::config_reloaded:
+      return "config_reloaded";
+    case EventKind::config_rejected:
+      return "config_rejected";
+  }
+  return "unknown";
+}
+
+inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
+
+struct Event {
+  EventKind kind = EventKind::alarm_raised;
+  // Source time of the sample that completed the deciding window [s] (the capture's t under
+  // replay, seconds since the group started otherwise); NaN for events not tied to a sample.
+  double t = kNoValue;
+  std::string actuator;     // empty for daemon-wide events
+  std::string alarm;        // "internal_leakage" for alarm events
+  std::string channel;      // the index channel (e.g. "p1"), or the driver name for driver events
+  std::string fault;        // sensor_fault alarms: frozen, saturated, spikes or dropout
+  double index = kNoValue;  // the index [Pa] that decided
+  double score = kNoValue;  // the detector's score
+  double baseline = kNoValue;  // learned healthy index [Pa]
+  // Leak size when the detector estimates one: C_L [m^3/(s Pa)], the same in l/min/MPa, and the
+  // flow in l/min at the current load pressure |p1 - p2|.
+  double leak_coefficient = kNoValue;
+  double leak_lpm_per_mpa = kNoValue;
+  double leak_lpm = kNoValue;
+  // 95 % half-widths of the two sizes above (statistics and the valve-gain uncertainty).
+  double leak_lpm_per_mpa_ci95 = kNoValue;
+  double leak_lpm_ci95 = kNoValue;
+  double load_pressure = kNoValue;  // |p1 - p2| [Pa] over the deciding hop
+  std::string message;              // human-readable detail (driver error text, counts...)
+  double unix_time = kNoValue;  // wall-clock time of publication [s since 1970], set by the worker
+  bool latched = false;         // alarm events: the alarm waits for acknowledgement
+};
+
+// Receives every event, in order, on the worker thread (never the real-time thread). publish()
+// must not block for long: a sink that talks to slow devices queues and writes elsewhere.
+class EventSink {
+ public:
+  EventSink() = default;
+  virtual ~EventSink() = default;
+  EventSink(const EventSink&) = delete;
+  EventSink& operator=(const EventSink&) = delete;
+
+  virtual void publish(const Event& event) = 0;
+  // Make everything published so far durable (called at least once a second and at shutdown).
+  virtual void flush() {}
+};
+
+}  // namespace leakmon::io

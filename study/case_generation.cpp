@@ -1,0 +1,175 @@
+#include "study/case_generation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <utility>
+
+namespace leakmon::study {
+namespace {
+
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+// A rig drawn across MODEL.md's calibration spread and the issue's load range.
+sim::Scenario draw_rig(std::mt19937_64& rng, int id, std::uint64_t seed, double duration,
+                       const std::vector<std::string>& effects) {
+  sim::Scenario s = sim::preset("healthy", seed);
+  s.name = fmt::format("evaluate-{}", id);
+  s.origin = fmt::format("leakmon evaluate run {}", id);
+  s.controller = id % 2 == 0 ? sim::ControllerKind::basic : sim::ControllerKind::fault_tolerant;
+  s.duration_s = duration;
+  s.params.K_s = uniform(rng, 40e3, 120e3);
+  s.params.beta *= uniform(rng, 0.75, 1.25);
+  s.params.Kv *= uniform(rng, 0.9, 1.1);
+  s.params.m *= uniform(rng, 0.8, 1.2);
+  s.params.b *= uniform(rng, 0.7, 1.3);
+  const double amplitude = uniform(rng, 0.6, 1.0);  // smaller steps excite the index less
+  s.reference.amp_min *= amplitude;
+  s.reference.amp_max *= amplitude;
+  for (const auto& effect : effects) s.effects.enable(effect);
+  return s;
+}
+
+// Draws the operating condition's parameters onto the scenario (MODEL.md "Drifting operating
+// conditions" and "Sensor faults"), from its own stream so the rig draws of the other runs stay
+// as they are. `healthy_from`..`healthy_to` is where a sensor fault may sit.
+void apply_operating(const std::string& operating, std::mt19937_64& rng, double healthy_from,
+                     double healthy_to, RunSpec& run) {
+  if (operating == "stationary") return;
+  sim::Scenario& s = run.scenario;
+  s.record.temp = true;
+  s.record.ps = true;
+  const int grades[] = {32, 46, 68};
+  s.conditions.oil = *sim::Oil::iso_vg(grades[std::uniform_int_distribution<int>(0, 2)(rng)]);
+  sim::TemperatureProfile profile;
+  if (operating == "warmup") {
+    profile.kind = sim::TemperatureProfile::Kind::warm_up;
+    profile.T0 = uniform(rng, 15.0, 35.0);
+    profile.T_work = uniform(rng, 45.0, 55.0);
+    profile.tau_s = uniform(rng, 300.0, 1200.0);
+    s.conditions.temperature = profile;
+    if (run.leak > 0.0) {
+      // The leak opens anywhere from early in the warm-up to well after it (1.5 time constants).
+      const double after = s.duration_s - run.onset;
+      run.onset = healthy_from + uniform(rng, 20.0, 20.0 + 1.5 * profile.tau_s);
+      s.duration_s = run.onset + after;
+      s.effects.internal_leakage->onset_s = run.onset;
+    }
+  } else if (operating == "cooler") {
+    profile.kind = sim::TemperatureProfile::Kind::cooler;
+    profile.T_work = uniform(rng, 45.0, 55.0);
+    profile.amplitude = uniform(rng, 1.0, 4.0);
+    profile.period_s = uniform(rng, 300.0, 1200.0);
+    // The cycle's phase at the start of learning is random too.
+    profile.cooler_start_s = -uniform(rng, 0.0, profile.period_s);
+    s.conditions.temperature = profile;
+  } else if (operating == "supply") {
+    const int changes = std::uniform_int_distribution<int>(1, 2)(rng);
+    double t = healthy_from;
+    for (int i = 0; i < changes && t < healthy_to; ++i) {
+      t = uniform(rng, t + 10.0, std::max(t + 10.0, healthy_to - 30.0));
+      const double ramp = uniform(rng, 0.0, 5.0);
+      s.conditions.supply.push_back({t, uniform(rng, 13e6, 20e6), ramp});
+      t += ramp;
+    }
+  } else if (operating == "sensor-faults") {
+    sim::SensorFault fault;
+    const sim::SensorChannel channels[] = {sim::SensorChannel::p1, sim::SensorChannel::p2,
+                                           sim::SensorChannel::x};
+    fault.channel = channels[std::uniform_int_distribution<int>(0, 2)(rng)];
+    const int kind = std::uniform_int_distribution<int>(0, 5)(rng);
+    fault.kind = kind == 0   ? sim::SensorFault::Kind::frozen
+                 : kind <= 2 ? sim::SensorFault::Kind::saturated
+                 : kind == 3 ? sim::SensorFault::Kind::spikes
+                             : sim::SensorFault::Kind::dropout;
+    fault.high = kind == 1;
+    fault.gap = kind == 5;
+    fault.duration_s = uniform(rng, 10.0, 60.0);
+    fault.start_s = uniform(rng, healthy_from + 10.0,
+                            std::max(healthy_from + 10.0, healthy_to - fault.duration_s - 10.0));
+    // Spikes: a few per minute, MODEL.md; off by MPa on a pressure, by millimetres on x.
+    fault.rate_per_min = uniform(rng, 3.0, 10.0);
+    fault.magnitude =
+        fault.channel == sim::SensorChannel::x ? uniform(rng, 2e-3, 1e-2) : uniform(rng, 1e6, 4e6);
+    run.fault_channel = std::string(sim::to_string(fault.channel));
+    run.fault_kind = std::string(sim::to_string(fault.kind));
+    run.fault_start = fault.start_s;
+    run.fault_end = fault.start_s + fault.duration_s;
+    s.faults.push_back(fault);
+  }
+}
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+
+}  // namespace
+
+std::vector<Condition> plan_conditions(const EvaluationOptions& options) {
+  std::vector<Condition> plan;
+  // Each kind of run cycles through the operating conditions, so every condition gets its share
+  // of healthy time and of every leak size.
+  const auto& operating = options.conditions;
+  auto pick = [&](int i) {
+    return operating.empty() ? std::string("stationary")
+                             : operating[static_cast<std::size_t>(i) % operating.size()];
+  };
+  for (int i = 0; i < options.healthy_runs; ++i) {
+    plan.push_back({HealthyCondition{options.healthy_seconds}, options.effects, pick(i)});
+  }
+  for (double leak : options.leak_sizes) {
+    for (int i = 0; i < options.runs_per_leak; ++i) {
+      plan.push_back({LeakCondition{leak, options.after_onset_seconds}, options.effects, pick(i)});
+    }
+  }
+  return plan;
+}
+
+std::uint64_t simulation_seed(std::uint64_t seed, int id) {
+  return seed * 100003 + static_cast<std::uint64_t>(id);
+}
+
+RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
+                      std::mt19937_64& rig_draws, const EvaluationOptions& options) {
+  RunSpec run;
+  run.id = id;
+  run.condition = condition;
+  run.monitor_from = options.settle_seconds + options.learn_seconds + 1.0;
+  std::visit(Overloaded{
+                 [&](const HealthyCondition& healthy) {
+                   run.scenario = draw_rig(rig_draws, id, seed, healthy.seconds, condition.effects);
+                 },
+                 [&](const LeakCondition& leak) {
+                   run.leak = leak.coefficient;
+                   // A healthy stretch after learning (false alarms count there too), then the
+                   // leak.
+                   run.onset = run.monitor_from + uniform(rig_draws, 20.0, 60.0);
+                   run.scenario = draw_rig(rig_draws, id, seed,
+                                           run.onset + leak.after_onset_seconds, condition.effects);
+                   run.scenario.effects.internal_leakage =
+                       sim::InternalLeakage{leak.coefficient, run.onset, 0.0};
+                 },
+             },
+             condition.kind);
+  std::mt19937_64 operating_draws(seed ^ 0x6a09e667f3bcc909ULL);
+  apply_operating(condition.operating, operating_draws, run.monitor_from,
+                  std::min(run.onset, run.scenario.duration_s), run);
+  return run;
+}
+
+std::vector<RunSpec> draw_runs(const EvaluationOptions& options) {
+  std::mt19937_64 rig_draws(options.seed);
+  std::vector<RunSpec> runs;
+  int id = 0;
+  for (const Condition& condition : plan_conditions(options)) {
+    runs.push_back(
+        generate_case(id, simulation_seed(options.seed, id), condition, rig_draws, options));
+    ++id;
+  }
+  return runs;
+}
+
+}  // namespace leakmon::study

@@ -1,0 +1,29 @@
+// The evaluation's files (docs/detection.md; docs/tools/detection_plots.py and
+// detection_tables.py read them): runs.json, summary.json, summary.tsv, summary.md and
+// size_coverage.tsv.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "study/evaluation_options.hpp"
+#include "study/evaluation_runner.hpp"
+
+namespace leakmon::study {
+
+// Every run with its rig and each candidate's alarms at the design threshold.
+void write_runs_json(const std::filesystem::path& path, const std::vector<RunResult>& results);
+
+// summary.json, summary.tsv, summary.md and size_coverage.tsv into `dir`: per candidate, per
+// threshold (ROC) and per leak size and controller; the Markdown at the design thresholds.
+void write_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
+                     const std::vector<RunResult>& results);
+
+// conditions.md and conditions.tsv into `dir`: per operating condition (options.conditions), each
+// candidate's false alarms per healthy hour (count, hours, 95 % upper bound) and detection within
+// the window per leak size at its design threshold; for sensor-faults runs, how many faults were
+// named on the right channel within 5 s, and any internal_leakage raised while one was present.
+void write_condition_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
+                               const std::vector<RunResult>& results);
+
+}  // namespace leakmon::study

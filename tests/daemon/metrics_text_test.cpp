@@ -1,0 +1,129 @@
+// The Prometheus text writer on its own: label escaping, histogram series and the exposition
+// layout (HELP, TYPE, then samples), without a daemon or a socket.
+#include "daemon/metrics_text.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace leakmon::daemon {
+namespace {
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(MetricsText, LabelValuesEscapeBackslashQuoteAndNewline) {
+  EXPECT_EQ(escape_label_value("plain-name_1.x"), "plain-name_1.x");
+  EXPECT_EQ(escape_label_value(R"(a"b)"), R"(a\"b)");
+  EXPECT_EQ(escape_label_value(R"(c:\dir)"), R"(c:\\dir)");
+  EXPECT_EQ(escape_label_value("two\nlines"), R"(two\nlines)");
+  EXPECT_EQ(escape_label_value("\\\"\n"), R"(\\\"\n)");
+  EXPECT_EQ(label("driver", "rig \"A\""), R"(driver="rig \"A\"")");
+}
+
+TEST(MetricsText, NumbersRoundTripAndNonFiniteIsNaN) {
+  EXPECT_EQ(metric_number(0.1), "0.1");
+  EXPECT_EQ(metric_number(1234.5), "1234.5");
+  EXPECT_EQ(metric_number(std::numeric_limits<double>::quiet_NaN()), "NaN");
+  EXPECT_EQ(metric_number(std::numeric_limits<double>::infinity()), "NaN");
+  const double third = 1.0 / 3.0;
+  EXPECT_EQ(std::stod(metric_number(third)), third);
+}
+
+TEST(MetricsText, FamilyHeaderThenSamples) {
+  PrometheusText out;
+  out.family("leakmon_x_total", "things counted", "counter");
+  out.sample("leakmon_x_total", "", std::uint64_t{7});
+  out.sample("leakmon_x_total", label("group", "fast"), std::uint64_t{3});
+  out.family("leakmon_t_seconds", "a time", "gauge");
+  out.sample("leakmon_t_seconds", "", std::int64_t{-2});
+  out.sample("leakmon_t_seconds", label("a", "1") + "," + label("b", "2"), 0.25);
+  EXPECT_EQ(out.text(),
+            "# HELP leakmon_x_total things counted\n"
+            "# TYPE leakmon_x_total counter\n"
+            "leakmon_x_total 7\n"
+            "leakmon_x_total{group=\"fast\"} 3\n"
+            "# HELP leakmon_t_seconds a time\n"
+            "# TYPE leakmon_t_seconds gauge\n"
+            "leakmon_t_seconds -2\n"
+            "leakmon_t_seconds{a=\"1\",b=\"2\"} 0.25\n");
+}
+
+TEST(MetricsText, HistogramBucketsAreCumulativeWithInfSumAndCount) {
+  PrometheusText out;
+  const double bounds[] = {1e-5, 1e-3, 0.5};
+  const std::uint64_t cumulative[] = {2, 5, 9};
+  out.histogram("lat_seconds", label("group", "g"), bounds, cumulative, 11, 1.75);
+  EXPECT_EQ(out.text(),
+            "lat_seconds_bucket{group=\"g\",le=\"1e-05\"} 2\n"
+            "lat_seconds_bucket{group=\"g\",le=\"0.001\"} 5\n"
+            "lat_seconds_bucket{group=\"g\",le=\"0.5\"} 9\n"
+            "lat_seconds_bucket{group=\"g\",le=\"+Inf\"} 11\n"
+            "lat_seconds_sum{group=\"g\"} 1.75\n"
+            "lat_seconds_count{group=\"g\"} 11\n");
+}
+
+TEST(MetricsText, HistogramWithoutLabelsHasOnlyLe) {
+  PrometheusText out;
+  const double bounds[] = {2.0};
+  const std::uint64_t cumulative[] = {0};
+  out.histogram("h", "", bounds, cumulative, 0, 0.0);
+  const auto lines = lines_of(out.text());
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[0], "h_bucket{le=\"2\"} 0");
+  EXPECT_EQ(lines[1], "h_bucket{le=\"+Inf\"} 0");
+}
+
+TEST(MetricsText, HistogramRejectsBoundsAndCountsOfDifferentLength) {
+  PrometheusText out;
+  const double bounds[] = {1.0, 2.0};
+  const std::uint64_t cumulative[] = {1};
+  EXPECT_THROW(out.histogram("h", "", bounds, cumulative, 1, 1.0), std::invalid_argument);
+}
+
+// Every line of a mixed exposition has the format's shape: a comment of HELP or TYPE, or
+// `name{labels} value` with quoted, escaped label values; TYPE follows the HELP of its family.
+TEST(MetricsText, ExpositionLinesHaveTheTextFormatShape) {
+  PrometheusText out;
+  out.family("leakmon_driver_up", "1 when ok", "gauge");
+  out.sample("leakmon_driver_up", label("driver", "bus \"0\"\\x\n") + "," + label("state", "ok"),
+             std::uint64_t{1});
+  out.family("leakmon_lat_seconds", "latency", "histogram");
+  const double bounds[] = {1e-4, 1e-3};
+  const std::uint64_t cumulative[] = {1, 2};
+  out.histogram("leakmon_lat_seconds", label("group", "a,b"), bounds, cumulative, 3, 0.01);
+  out.sample("leakmon_score", "", std::numeric_limits<double>::quiet_NaN());
+
+  const std::regex help(R"(# HELP [a-zA-Z_:][a-zA-Z0-9_:]* .*)");
+  const std::regex type(R"(# TYPE ([a-zA-Z_:][a-zA-Z0-9_:]*) (counter|gauge|histogram))");
+  const std::regex sample(
+      R"([a-zA-Z_:][a-zA-Z0-9_:]*(\{([a-zA-Z_][a-zA-Z0-9_]*="([^"\\\n]|\\[\\"n])*",?)*\})? )"
+      R"((NaN|\+Inf|-?[0-9.e+-]+))");
+  std::string last_help;
+  const auto lines = lines_of(out.text());
+  ASSERT_EQ(lines.size(), 2u + 1u + 2u + 5u + 1u);
+  for (const auto& line : lines) {
+    std::smatch m;
+    if (line.rfind("# HELP ", 0) == 0) {
+      EXPECT_TRUE(std::regex_match(line, help)) << line;
+      last_help = line.substr(7, line.find(' ', 7) - 7);
+    } else if (line.rfind("# TYPE ", 0) == 0) {
+      ASSERT_TRUE(std::regex_match(line, m, type)) << line;
+      EXPECT_EQ(m[1].str(), last_help) << line;
+    } else {
+      EXPECT_TRUE(std::regex_match(line, sample)) << line;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace leakmon::daemon

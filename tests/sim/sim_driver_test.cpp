@@ -1,0 +1,54 @@
+// The daemon's sim driver passes the scenario's drifting conditions, sensor faults and optional
+// transducers through: ps and temp are channels when the scenario records them (or when named),
+// and a dropped-out channel reads NaN (a gap) on the real-time path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "io/sim/sim_driver.hpp"
+#include "tests/support/alloc_counter.hpp"
+
+namespace leakmon::io {
+namespace {
+
+TEST(SimDriverChannels, RecordedTransducersAndFaultsReachTheDriver) {
+  SimSettings settings;
+  settings.scenario = sim::preset("healthy", 2);
+  sim::TemperatureProfile hot;
+  hot.T_work = 52.0;
+  settings.scenario.conditions.temperature = hot;
+  settings.scenario.record.temp = true;
+  sim::SensorFault gap{sim::SensorFault::Kind::dropout, sim::SensorChannel::p2, 0.1, 0.1};
+  gap.gap = true;
+  settings.scenario.faults = {gap};
+  SimDriver driver(settings);
+  EXPECT_EQ(std::vector<std::string>(driver.channels().begin(), driver.channels().end()),
+            (std::vector<std::string>{"xref", "u", "x", "p1", "p2", "q_int", "temp"}));
+  driver.start();
+  std::vector<double> values(driver.channels().size());
+  int gaps = 0;
+  {
+    test::AllocationScope scope;
+    for (std::uint64_t k = 0; k < 200; ++k) {
+      ASSERT_EQ(driver.read(Tick{k, 0}, values), ReadStatus::ok);
+      EXPECT_NEAR(values[6], 52.0, 0.3);
+      gaps += std::isnan(values[4]);
+      EXPECT_FALSE(std::isnan(values[3]));
+    }
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  EXPECT_EQ(gaps, 50);  // 0.1 s at 500 Hz
+
+  settings.channels = {"p1", "ps"};
+  SimDriver named(settings);
+  named.start();
+  std::vector<double> two(2);
+  ASSERT_EQ(named.read(Tick{0, 0}, two), ReadStatus::ok);
+  EXPECT_NEAR(two[1], 17.2e6, 3e4);
+  settings.channels = {"flow"};
+  EXPECT_THROW(SimDriver{settings}, DriverError);
+}
+
+}  // namespace
+}  // namespace leakmon::io

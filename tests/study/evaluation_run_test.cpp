@@ -1,0 +1,155 @@
+// The evaluation harness called directly on a handful of short simulated runs: case generation
+// reproduces a master seed and shapes each condition's scenario, the runner replays through the
+// daemon's pipeline, a healthy rig raises nothing and a large leak is found within a minute.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <variant>
+
+#include "capture/capture.hpp"
+#include "study/case_generation.hpp"
+#include "study/evaluation_runner.hpp"
+#include "study/evaluation_summary.hpp"
+#include "study/evaluation_writers.hpp"
+#include "tests/support/paths.hpp"
+
+namespace leakmon::study {
+namespace {
+
+EvaluationOptions short_options(std::uint64_t seed) {
+  EvaluationOptions options;
+  options.healthy_runs = 1;
+  options.healthy_seconds = 150.0;
+  options.runs_per_leak = 1;
+  options.leak_sizes = {5e-12};
+  options.learn_seconds = 30.0;
+  options.after_onset_seconds = 60.0;
+  options.seed = seed;
+  options.jobs = 2;
+  std::printf("evaluation seed %llu\n", static_cast<unsigned long long>(seed));
+  return options;
+}
+
+std::size_t candidate_index(const char* label) {
+  const auto all = candidates();
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    if (all[c].label == label) return c;
+  }
+  ADD_FAILURE() << "no candidate " << label;
+  return 0;
+}
+
+TEST(CaseGeneration, PlansHealthyThenLeakRunsAndReproducesTheSeed) {
+  EvaluationOptions options = short_options(7);
+  options.healthy_runs = 2;
+  options.runs_per_leak = 2;
+  options.leak_sizes = {1e-12, 2e-12};
+  options.effects = {"coulomb_friction"};
+  const auto plan = plan_conditions(options);
+  ASSERT_EQ(plan.size(), 6u);
+  EXPECT_TRUE(std::holds_alternative<HealthyCondition>(plan[1].kind));
+  ASSERT_TRUE(std::holds_alternative<LeakCondition>(plan[4].kind));
+  EXPECT_EQ(std::get<LeakCondition>(plan[4].kind).coefficient, 2e-12);
+  EXPECT_EQ(plan[5].effects, options.effects);
+
+  const auto runs = draw_runs(options);
+  const auto again = draw_runs(options);
+  ASSERT_EQ(runs.size(), 6u);
+  const double monitor_from = options.settle_seconds + options.learn_seconds + 1.0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const RunSpec& r = runs[i];
+    EXPECT_EQ(r.id, static_cast<int>(i));
+    EXPECT_EQ(r.scenario.params.K_s, again[i].scenario.params.K_s);  // same seed, same rig
+    EXPECT_GE(r.scenario.params.K_s, 40e3);
+    EXPECT_LE(r.scenario.params.K_s, 120e3);
+    EXPECT_EQ(r.scenario.seed, simulation_seed(7, r.id));
+    EXPECT_EQ(r.monitor_from, monitor_from);
+    EXPECT_TRUE(r.scenario.effects.coulomb_friction.has_value());
+    if (i < 2) {
+      EXPECT_EQ(r.leak, 0.0);
+      EXPECT_EQ(r.scenario.duration_s, options.healthy_seconds);
+      EXPECT_FALSE(r.scenario.effects.internal_leakage.has_value());
+    } else {
+      EXPECT_EQ(r.leak, i < 4 ? 1e-12 : 2e-12);
+      EXPECT_GE(r.onset, monitor_from + 20.0);
+      EXPECT_LE(r.onset, monitor_from + 60.0);
+      EXPECT_DOUBLE_EQ(r.scenario.duration_s, r.onset + options.after_onset_seconds);
+      ASSERT_TRUE(r.scenario.effects.internal_leakage.has_value());
+    }
+  }
+  EXPECT_NE(runs[0].scenario.params.K_s, runs[1].scenario.params.K_s);
+  EXPECT_NE(draw_runs(short_options(8))[0].scenario.params.K_s, runs[0].scenario.params.K_s);
+
+  // A condition on its own: a leak case from a given seed and draw stream.
+  std::mt19937_64 draws(11);
+  const RunSpec one = generate_case(3, 1234, {LeakCondition{3e-12, 75.0}, {}}, draws, options);
+  EXPECT_EQ(one.leak, 3e-12);
+  EXPECT_EQ(one.scenario.seed, 1234u);
+  EXPECT_DOUBLE_EQ(one.scenario.duration_s, one.onset + 75.0);
+  EXPECT_EQ(one.scenario.controller, sim::ControllerKind::fault_tolerant);  // odd id
+}
+
+// One healthy and one large-leak run through the runner, the aggregation and the writers.
+TEST(EvaluationRun, HealthyRigIsQuietAndALargeLeakIsFoundWithinAMinute) {
+  for (std::uint64_t seed : {3u, 4u}) {
+    EvaluationOptions options = short_options(seed);
+    options.out = test::scratch_dir("study_evaluation_run_" + std::to_string(seed));
+    options.keep_captures = {1};
+    const auto runs = draw_runs(options);
+    std::size_t progress_calls = 0;
+    const auto results = run_evaluation(runs, options, [&](std::size_t done, std::size_t total) {
+      EXPECT_EQ(done, ++progress_calls);
+      EXPECT_EQ(total, runs.size());
+    });
+    ASSERT_EQ(results.size(), 2u);
+    EXPECT_EQ(progress_calls, 2u);
+    EXPECT_EQ(results[1].spec.id, 1);
+    EXPECT_TRUE(std::filesystem::exists(options.out / "run-1.csv"));
+    EXPECT_FALSE(std::filesystem::exists(options.out / "run-0.csv"));
+
+    const auto all = candidates();
+    for (const char* label : {"default", "flow_balance"}) {
+      const std::size_t c = candidate_index(label);
+      const std::size_t design = design_index(all[c]);
+      // The healthy run raises nothing at the design threshold.
+      EXPECT_TRUE(results[0].alarms[c][design].empty()) << label << " seed " << seed;
+      const Rates rates = rates_of(results, c, design, "all", 0.0, options.detect_within);
+      EXPECT_EQ(rates.false_alarms, 0) << label << " seed " << seed;
+      EXPECT_EQ(rates.leak_runs, 1);
+      EXPECT_EQ(rates.detected, 1) << label << " seed " << seed;
+      ASSERT_EQ(rates.delays.size(), 1u);
+      EXPECT_LT(rates.delays[0], 60.0) << label << " seed " << seed;
+      EXPECT_GE(rates.delays[0], 0.0);
+    }
+    // The flow balance's first raise carries a size whose interval is finite.
+    EXPECT_FALSE(std::isnan(results[1].size_check.leak_coefficient));
+    EXPECT_GT(results[1].size_check.half_width, 0.0);
+
+    write_runs_json(options.out / "runs.json", results);
+    write_summaries(options.out, options, results);
+    for (const char* file :
+         {"runs.json", "summary.json", "summary.tsv", "summary.md", "size_coverage.tsv"}) {
+      EXPECT_GT(std::filesystem::file_size(options.out / file), 100u) << file;
+    }
+  }
+}
+
+TEST(EvaluationRun, AFailingRunIsReportedWithItsId) {
+  EvaluationOptions options = short_options(5);
+  options.out = test::scratch_dir("study_evaluation_failure") + "/missing/dir";
+  options.keep_captures = {0};  // the capture cannot be written there
+  auto runs = draw_runs(options);
+  runs.resize(1);
+  runs[0].scenario.duration_s = 5.0;
+  try {
+    run_evaluation(runs, options);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("run 0: ", 0), 0u) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace leakmon::study
