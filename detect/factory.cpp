@@ -1,7 +1,9 @@
 #include "detect/factory.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <initializer_list>
+#include <numbers>
 #include <span>
 #include <stdexcept>
 #include <string_view>
@@ -26,6 +28,12 @@ bool has_all(const AvailableSignals& s) { return s.p1 && s.p2 && s.u && s.x; }
 void read(const config::ConfigNode* options, std::string_view key, double& value, double lo,
           double hi) {
   if (options != nullptr) value = options->get_double(key, value, lo, hi);
+}
+
+// The rig table holds bore and rod (A = pi/4 (D^2 - d^2)); a configured piston_area keeps the
+// rod and sets the bore that gives that area.
+void set_piston_area(sim::Parameters& rig, double area) {
+  rig.D = std::sqrt(4.0 * area / std::numbers::pi + rig.d * rig.d);
 }
 
 void read_learning(const config::ConfigNode* options, LearningSchedule& learning) {
@@ -110,8 +118,8 @@ IndexCusumOptions index_options(const config::ConfigNode* options, const Availab
   read(options, "design_drop", o.design_drop, 0.005, 0.9);
   read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
   read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
-  read(options, "supply_pressure", o.supply_pressure, 1e5, 1e9);
-  read(options, "tank_pressure", o.tank_pressure, 0.0, 1e8);
+  read(options, "supply_pressure", o.rig.ps, 1e5, 1e9);
+  read(options, "tank_pressure", o.rig.pt, 0.0, 1e8);
   read(options, "min_drop", o.min_drop, 0.0, 0.5);
   read(options, "temperature_prior", o.temperature_prior, -2.0, 2.0);
   read(options, "temperature_prior_sigma", o.temperature_prior_sigma, 1e-4, 10.0);
@@ -134,12 +142,14 @@ IndexCusumOptions index_options(const config::ConfigNode* options, const Availab
 FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {
   FlowBalanceOptions o;
   read_learning(options, o.learning);
-  read(options, "supply_pressure", o.valve.supply_pressure, 1e5, 1e9);
-  read(options, "tank_pressure", o.valve.tank_pressure, 0.0, 1e8);
-  read(options, "command_full_scale", o.valve.command_full_scale, 1e-3, 1e3);
-  read(options, "valve_coefficient", o.valve_coefficient, 1e-12, 1.0);
+  read(options, "supply_pressure", o.rig.ps, 1e5, 1e9);
+  read(options, "tank_pressure", o.rig.pt, 0.0, 1e8);
+  read(options, "command_full_scale", o.rig.u_max, 1e-3, 1e3);
+  read(options, "valve_coefficient", o.rig.Kv, 1e-12, 1.0);
   read(options, "valve_coefficient_uncertainty", o.valve_coefficient_uncertainty, 0.0, 1.0);
-  read(options, "piston_area", o.piston_area, 1e-8, 10.0);
+  double piston_area = o.rig.A();
+  read(options, "piston_area", piston_area, 1e-8, 10.0);
+  set_piston_area(o.rig, piston_area);
   read(options, "rest_speed", o.rest_speed, 1e-6, 10.0);
   read(options, "design_leak", o.design_leak, 1e-16, 1e-8);
   read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);

@@ -44,10 +44,9 @@ FlowBalanceDetector::FlowBalanceDetector(const FlowBalanceOptions& options, doub
           static_cast<std::size_t>(
               std::ceil(options.min_rest_fraction * static_cast<double>(block_hops_))),
           1)),
-      design_slope_(options.design_leak * std::sqrt(options.valve.supply_pressure) /
-                    options.valve_coefficient),
-      floor_slope_(options.min_leak * std::sqrt(options.valve.supply_pressure) /
-                   options.valve_coefficient),
+      piston_area_(options.rig.A()),
+      design_slope_(options.design_leak * std::sqrt(options.rig.ps) / options.rig.Kv),
+      floor_slope_(options.min_leak * std::sqrt(options.rig.ps) / options.rig.Kv),
       sizing_decay_(std::exp(-options.block_seconds / options.sizing_seconds)),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)) {
   learned_.reserve(learn_hops_);
@@ -112,7 +111,7 @@ double FlowBalanceDetector::drift_slope(double t) const {
 }
 
 double FlowBalanceDetector::supply_for(const Observation& o, double speed) {
-  const double configured = options_.valve.supply_pressure;
+  const double configured = options_.rig.ps;
   double reading = kMissing;
   if (!std::isnan(o.ps)) {
     reading = o.ps;
@@ -120,7 +119,7 @@ double FlowBalanceDetector::supply_for(const Observation& o, double speed) {
              std::abs(speed) < options_.rest_speed &&
              std::abs(pending_.speed) < options_.rest_speed) {
     // At rest the valve's lands balance: p1 + p2 = ps + pt (MODEL.md).
-    reading = o.p1 + o.p2 - options_.valve.tank_pressure;
+    reading = o.p1 + o.p2 - options_.rig.pt;
   }
   if (!std::isnan(reading)) {
     if (std::isnan(supply_estimate_) ||
@@ -279,7 +278,7 @@ Decision FlowBalanceDetector::update(const Observation& o) {
   // Load, root factor and leak term are scaled by the configured supply (a constant), so the
   // learned coefficients keep their meaning when the actual supply moves; the orifice law
   // itself is evaluated at the actual supply.
-  const double ps_ref = options_.valve.supply_pressure;
+  const double ps_ref = options_.rig.ps;
   Hop hop;
   hop.t = o.t;
   hop.speed = (o.x - previous_x_) / hop_seconds_;
@@ -291,23 +290,20 @@ Decision FlowBalanceDetector::update(const Observation& o) {
       std::isnan(supply_settled_since_) || o.t - supply_settled_since_ >= kSupplySettleSeconds;
   hop.usable = !std::isnan(o.u) && !std::isnan(o.p1) && !std::isnan(o.p2) &&
                !std::isnan(hop.speed) && temperature_ok && supply_settled &&
-               std::abs(o.u) < 0.5 * options_.valve.command_full_scale;
+               std::abs(o.u) < 0.5 * options_.rig.u_max;
   if (hop.usable) {
     // Judged in the command's own units (fractions of full spool travel), on the side the
     // load makes the valve open to at rest (it feeds the leaks out of the loaded chamber): so
     // a command offset or a dead band is a constant whatever the command's sign, where the
     // orifice law read through the measured command would switch sides at the wrong place.
     // Load in units of ps, root factor in units of sqrt(ps).
-    ValveGeometry valve = options_.valve;
-    valve.supply_pressure = hop.supply;
+    sim::Parameters rig = options_.rig;
+    rig.ps = hop.supply;
     hop.load = (o.p1 - o.p2) / ps_ref;
-    const double full_open = std::copysign(valve.command_full_scale, hop.load);
-    const double root =
-        std::abs(load_flow_per_kv(valve, full_open, o.p1, o.p2)) / std::sqrt(ps_ref);
+    const double full_open = std::copysign(rig.u_max, hop.load);
+    const double root = std::abs(load_flow_per_kv(rig, full_open, o.p1, o.p2)) / std::sqrt(ps_ref);
     hop.usable = hop.usable && root > kMinRoot;
-    hop.opening =
-        o.u / valve.command_full_scale -
-        options_.piston_area * hop.speed / (options_.valve_coefficient * std::sqrt(ps_ref) * root);
+    hop.opening = o.u / rig.u_max - piston_area_ * hop.speed / (rig.Kv * std::sqrt(ps_ref) * root);
     // Laminar leaks follow the viscosity: scaled to 40 degC, the learned null leakage and any
     // new leak are constants of the rig.
     hop.viscosity_ratio = std::isnan(o.temp) ? kMissing : options_.oil.ratio(o.temp);
@@ -324,7 +320,7 @@ Decision FlowBalanceDetector::update(const Observation& o) {
 }
 
 void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
-  const double ps = options_.valve.supply_pressure;  // the scale of the slope (see update())
+  const double ps = options_.rig.ps;  // the scale of the slope (see update())
   Decision decision;
   ++hops_seen_;
   if (hops_seen_ <= settle_hops_) {
@@ -363,7 +359,7 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
                           : change_block_.ll > 0.0 ? change_block_
                                                    : weighted_;
   if (sums.ll > 0.0) {
-    const double to_leak = options_.valve_coefficient / std::sqrt(ps);
+    const double to_leak = options_.rig.Kv / std::sqrt(ps);
     const double slope = sums.rl / sums.ll;
     const double slope_se = block_sigma_ * std::sqrt(sums.ll_sq) / sums.ll;
     decision.leak_coefficient = slope * to_leak;

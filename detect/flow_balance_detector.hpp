@@ -34,15 +34,17 @@
 #include "detect/learning_schedule.hpp"
 #include "detect/valve_flow.hpp"
 #include "sim/oil.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::detect {
 
 struct FlowBalanceOptions {
   LearningSchedule learning;
-  ValveGeometry valve;
-  double valve_coefficient = 3.39e-7;          // nominal Kv [m^3/(s sqrt(Pa))]
+  // The rig table: ps, pt, u_max, dp_lin, the nominal Kv and the piston area A() are used
+  // (options supply_pressure, tank_pressure, command_full_scale, valve_coefficient,
+  // piston_area).
+  sim::Parameters rig;
   double valve_coefficient_uncertainty = 0.1;  // relative
-  double piston_area = 6.334e-4;               // A [m^2]
   // A hop is at rest when |dx/dt| stays below rest_speed over it and both its neighbours: a hop
   // that holds the first or last few samples of a move carries flows the balance does not model.
   double rest_speed = 2e-3;      // [m/s]
@@ -124,6 +126,7 @@ class FlowBalanceDetector final : public Detector {
   FlowBalanceOptions options_;
   double hop_seconds_;
   std::size_t settle_hops_, learn_hops_, block_hops_, min_rest_hops_;
+  double piston_area_;   // A() of the rig table, computed once
   double design_slope_;  // design_leak in the normalised units of the regression
   double floor_slope_;   // min_leak in the same units
   double sizing_decay_;  // per block

@@ -89,7 +89,7 @@ double IndexCusumDetector::log_index_of(const Observation& o) const {
 // Load pressure p1 - p2 over supply; with one chamber, that chamber's departure from mid-supply
 // (the two chambers mirror each other around it at rest).
 double IndexCusumDetector::load_of(const Observation& o, double ps) const {
-  const double pt = options_.tank_pressure;
+  const double pt = options_.rig.pt;
   if (options_.use_p1 && options_.use_p2 && !std::isnan(o.p1) && !std::isnan(o.p2)) {
     return (o.p1 - o.p2) / ps;
   }
@@ -102,7 +102,7 @@ double IndexCusumDetector::load_of(const Observation& o, double ps) const {
 // either exists. A step restarts the settling clock and the drift reference (the index level
 // before it belongs to another supply).
 double IndexCusumDetector::supply_for(const Observation& o, double load) {
-  const double configured = options_.supply_pressure;
+  const double configured = options_.rig.ps;
   double reading = kMissing;
   bool direct = false;
   if (!std::isnan(o.ps)) {
@@ -110,7 +110,7 @@ double IndexCusumDetector::supply_for(const Observation& o, double load) {
     direct = true;
   } else if (options_.use_p1 && options_.use_p2 && !std::isnan(o.p1) && !std::isnan(o.p2) &&
              std::abs(load - previous_rough_load_) < kRestActivity) {
-    reading = o.p1 + o.p2 - options_.tank_pressure;
+    reading = o.p1 + o.p2 - options_.rig.pt;
   }
   previous_rough_load_ = load;
   if (std::isnan(reading)) return std::isnan(supply_estimate_) ? configured : supply_estimate_;
@@ -305,7 +305,7 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   if (hops_seen_ <= settle_hops_) return decision;
   if (!std::isnan(observation.temp)) temperature_seen_ = true;
 
-  const double rough_load = load_of(observation, options_.supply_pressure);
+  const double rough_load = load_of(observation, options_.rig.ps);
   const double supply = supply_for(observation, rough_load);
   Block block{};
   const bool completed =

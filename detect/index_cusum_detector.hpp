@@ -31,16 +31,16 @@
 #include "detect/detector.hpp"
 #include "detect/learning_schedule.hpp"
 #include "sim/oil.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::detect {
 
 struct IndexCusumOptions {
   LearningSchedule learning;
-  bool use_p1 = true, use_p2 = true;    // which chamber indices to use (if acquired)
-  double supply_pressure = 17.2e6;      // [Pa] configured supply (used until one is measured)
-  double tank_pressure = 0.0;           // [Pa] for the supply from p1 + p2 at rest
-  double design_drop = 0.08;            // relative index drop the CUSUM is tuned for
-  double min_drop = 0.02;               // relative drop that is never an alarm (the null)
+  bool use_p1 = true, use_p2 = true;  // which chamber indices to use (if acquired)
+  sim::Parameters rig;        // ps: the configured supply (used until one is measured); pt: tank
+  double design_drop = 0.08;  // relative index drop the CUSUM is tuned for
+  double min_drop = 0.02;     // relative drop that is never an alarm (the null)
   double false_alarms_per_hour = 0.05;  // sets the threshold
   double block_seconds = 0.8;           // one window (400 samples at 500 Hz)
   // -d ln(index) / d ln(friction factor 0.5 + 0.5/r) assumed as far as learning saw too little

@@ -1,10 +1,15 @@
-// The actuator of MODEL.md as a deterministic ODE, extended by any effect of the library.
-// The model check predicts the measured signals with it; the spool flow noise w of the nominal
-// model is process noise with zero mean, so the predictor uses its expectation, w = 0.
+// The model check's predictor: the simulator's actuator (the rates of sim/actuator.hpp, every
+// equation of MODEL.md written once) in a deterministic mode, driven open loop by the measured
+// u. The spool flow noise w of the nominal model is process noise with zero mean, so the
+// predictor uses its expectation, w = 0. What it adds to the simulator's Plant is what fitting
+// needs: the calibratable parameters and every effect parameter settable per evaluation, a
+// single lagging-transducer state, an adaptive sub-step count and, where even that cannot
+// resolve Coulomb friction's tanh(v / 1e-3), a widened sticking band.
 #pragma once
 
 #include "model/model_parameters.hpp"
-#include "model/rig_constants.hpp"
+#include "sim/actuator.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::model {
 
@@ -26,14 +31,20 @@ struct Reading {
 
 class ActuatorModel {
  public:
-  ActuatorModel(const ModelParameters& parameters, const RigConstants& rig = {});
+  // rig: the rig table; its beta, Kv, m, b are replaced by parameters.calibration.
+  explicit ActuatorModel(const ModelParameters& parameters,
+                         const sim::Parameters& rig = sim::Parameters::nominal());
 
   const ModelParameters& parameters() const { return parameters_; }
-  const RigConstants& rig() const { return rig_; }
-  double spool_tau() const { return spool_tau_; }
+  // The rig table with the calibration applied.
+  const sim::Parameters& rig() const { return rig_; }
+  const sim::ActuatorCoefficients& coefficients() const { return c_; }
+  double spool_tau() const { return c_.tau_spool; }
   // Integration sub-steps per sample interval: enough for RK4 to stay stable, since Coulomb
   // friction's tanh(v / 1e-3) is a very stiff damper near v = 0.
   int substeps(double dt) const;
+  // The tanh velocity scale used with sub-step h: 1e-3, widened where h cannot resolve it.
+  double friction_velocity(double h) const;
 
   // Advances `state` from t0 over dt with the valve command u held (zero-order hold).
   void advance(ActuatorState& state, double u, double t0, double dt) const;
@@ -41,19 +52,15 @@ class ActuatorModel {
 
   // Spool input sat((u + u0) / u_max) of MODEL.md's spool equation.
   double spool_input(double u) const;
-  // Supply pressure after ripple and droop; solves droop's algebraic loop.
-  double supply_pressure(double t, double opening, double p1, double p2) const;
-  double bulk_modulus(double p) const;
 
  private:
-  ActuatorState derivative(const ActuatorState& s, double spool_in, double t, double v_fric) const;
-  double friction_velocity(double h) const;
-  double opening(double xs) const;
+  ActuatorState derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
+                           double spool_in, double t) const;
 
   ModelParameters parameters_;
-  RigConstants rig_;
-  double spool_tau_;
-  double half_volume_;
+  sim::Parameters rig_;
+  sim::ActuatorCoefficients c_;
+  bool lagging_ = false;
 };
 
 }  // namespace leakmon::model

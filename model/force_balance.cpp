@@ -5,12 +5,13 @@
 #include <cmath>
 #include <vector>
 
+#include "sim/friction.hpp"
+
 namespace leakmon::model {
 namespace {
 
-constexpr int kVelocityHalfWindow = 3;      // as the segment predictor's velocity estimate
-constexpr double kFrictionVelocity = 1e-3;  // tanh(v / 1e-3) of coulomb_friction
-constexpr int kUnknowns = 6;                // m, b, F_C, constant, p1 lag, p2 lag
+constexpr int kVelocityHalfWindow = 3;  // as the segment predictor's velocity estimate
+constexpr int kUnknowns = 6;            // m, b, F_C, constant, p1 lag, p2 lag
 
 // Velocity from a least-squares line through x over +-3 samples.
 double velocity(const MeasuredRecord& r, std::size_t k) {
@@ -30,7 +31,8 @@ bool usable(const ForceBalance& estimate) {
 }
 
 ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<const Segment> segments,
-                                    const RigConstants& rig, std::size_t window_samples) {
+                                    const sim::Parameters& rig, std::size_t window_samples) {
+  const double area = rig.A();
   std::vector<std::array<double, kUnknowns + 1>> rows;
   for (const auto& seg : segments) {
     // Segments are gap-free with kVelocityHalfWindow valid samples on either side.
@@ -40,17 +42,17 @@ ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<cons
       double load = 0.0, friction = 0.0;
       for (std::size_t k = a; k < z; ++k) {  // trapezoidal integrals over [t_a, t_z]
         const auto force = [&](std::size_t j) {
-          return rig.area * (record.p1[j] - record.p2[j]) - rig.spring * record.x[j];
+          return area * (record.p1[j] - record.p2[j]) - rig.K_s * record.x[j];
         };
         load += 0.5 * record.dt * (force(k) + force(k + 1));
         friction += 0.5 * record.dt *
-                    (std::tanh(velocity(record, k) / kFrictionVelocity) +
-                     std::tanh(velocity(record, k + 1) / kFrictionVelocity));
+                    (sim::coulomb_friction(1.0, velocity(record, k)) +
+                     sim::coulomb_friction(1.0, velocity(record, k + 1)));
       }
       const double span = static_cast<double>(window_samples) * record.dt;
       rows.push_back({velocity(record, z) - velocity(record, a), record.x[z] - record.x[a],
-                      friction, span, rig.area * (record.p1[z] - record.p1[a]),
-                      -rig.area * (record.p2[z] - record.p2[a]), load});
+                      friction, span, area * (record.p1[z] - record.p1[a]),
+                      -area * (record.p2[z] - record.p2[a]), load});
     }
   }
   ForceBalance out;

@@ -14,8 +14,8 @@
 #include <span>
 
 #include "model/measured_record.hpp"
-#include "model/rig_constants.hpp"
 #include "model/segment_predictor.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::model {
 
@@ -33,6 +33,7 @@ bool usable(const ForceBalance& estimate);
 
 // Regression over windows of `window_samples` inside the given segments.
 ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<const Segment> segments,
-                                    const RigConstants& rig = {}, std::size_t window_samples = 25);
+                                    const sim::Parameters& rig = sim::Parameters::nominal(),
+                                    std::size_t window_samples = 25);
 
 }  // namespace leakmon::model

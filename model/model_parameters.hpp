@@ -4,13 +4,16 @@
 // EffectParameters is the nominal model.
 #pragma once
 
+#include "sim/parameters.hpp"
+
 namespace leakmon::model {
 
+// Starts at the rig table's nominal values (sim/parameters.hpp, the one table).
 struct Calibration {
-  double beta = 700e6;  // effective bulk modulus [Pa]
-  double Kv = 3.39e-7;  // valve coefficient [m^3/(s sqrt(Pa))]
-  double m = 10.0;      // moving mass [kg]
-  double b = 300.0;     // viscous friction [N s/m]
+  double beta = sim::Parameters{}.beta;  // effective bulk modulus [Pa]
+  double Kv = sim::Parameters{}.Kv;      // valve coefficient [m^3/(s sqrt(Pa))]
+  double m = sim::Parameters{}.m;        // moving mass [kg]
+  double b = sim::Parameters{}.b;        // viscous friction [N s/m]
 };
 
 enum class PressureChannel { p1, p2 };

@@ -57,7 +57,7 @@ std::vector<Segment> spread(std::span<const Segment> segments, std::size_t count
   return out;
 }
 
-SegmentPredictor::SegmentPredictor(const MeasuredRecord& record, const RigConstants& rig)
+SegmentPredictor::SegmentPredictor(const MeasuredRecord& record, const sim::Parameters& rig)
     : record_(record), rig_(rig) {
   scales_ = {std_dev(record.x, record.valid), std_dev(record.p1, record.valid),
              std_dev(record.p2, record.valid)};
@@ -119,7 +119,7 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
       if (!diverged) {
         model.advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt);
         diverged = !(std::isfinite(s.x) && std::isfinite(s.p1) && std::isfinite(s.p2) &&
-                     std::abs(s.x) < 10.0 * rig_.stroke && s.p1 < 1e9 && s.p2 < 1e9);
+                     std::abs(s.x) < 10.0 * rig_.L && s.p1 < 1e9 && s.p2 < 1e9);
       }
       visit(k, model.read(s), diverged);
     }

@@ -13,6 +13,7 @@
 
 #include "model/actuator_model.hpp"
 #include "model/measured_record.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::model {
 
@@ -48,7 +49,8 @@ struct ChannelScales {
 
 class SegmentPredictor {
  public:
-  explicit SegmentPredictor(const MeasuredRecord& record, const RigConstants& rig = {});
+  explicit SegmentPredictor(const MeasuredRecord& record,
+                            const sim::Parameters& rig = sim::Parameters::nominal());
 
   const MeasuredRecord& record() const { return record_; }
   const ChannelScales& scales() const { return scales_; }
@@ -73,7 +75,7 @@ class SegmentPredictor {
            Visit&& visit) const;
 
   const MeasuredRecord& record_;
-  RigConstants rig_;
+  sim::Parameters rig_;
   ChannelScales scales_;
   std::vector<double> velocity_;   // from a local least-squares line through x
   std::vector<double> dp1_, dp2_;  // central differences of the pressure readings

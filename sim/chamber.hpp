@@ -23,6 +23,11 @@ inline double entrained_air_bulk_modulus(double E_l, double alpha, double p_gaug
   return E_l * numerator / denominator;
 }
 
+// The bulk modulus in force: beta itself without entrained air (alpha = 0).
+inline double bulk_modulus(double beta, double alpha, double p_gauge) noexcept {
+  return alpha > 0.0 ? entrained_air_bulk_modulus(beta, alpha, p_gauge) : beta;
+}
+
 // dp/dt of one chamber: bulk modulus, volume, net port inflow, volume growth rate.
 inline double chamber_pressure_rate(double bulk_modulus, double volume, double inflow,
                                     double volume_rate) noexcept {

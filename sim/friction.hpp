@@ -8,8 +8,11 @@ namespace leakmon::sim {
 
 inline constexpr double kCoulombVelocityScale = 1e-3;  // m/s
 
-inline double coulomb_friction(double F_C, double v) noexcept {
-  return F_C * std::tanh(v / kCoulombVelocityScale);
+// velocity_scale > 1e-3 widens the sticking band where a fixed step cannot resolve the tanh
+// (the model check's coarse steps); the force outside the band is unchanged.
+inline double coulomb_friction(double F_C, double v,
+                               double velocity_scale = kCoulombVelocityScale) noexcept {
+  return F_C * std::tanh(v / velocity_scale);
 }
 
 }  // namespace leakmon::sim

@@ -1,5 +1,6 @@
 // The continuous actuator of MODEL.md (spool, valve, chambers, piston, end stops) with the
-// effect library, integrated by fixed-step RK4 over one sample with the command held. Usable
+// effect library (the rates of sim/actuator.hpp, shared with the model check), integrated by
+// fixed-step RK4 over one sample with the command held. Usable
 // open-loop (the model check drives it with a measured u) or inside Rig.
 //
 // The spool flow noise is an Ornstein-Uhlenbeck process drawn by its exact discretisation on a
@@ -10,6 +11,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 
+#include "sim/actuator.hpp"
 #include "sim/effects.hpp"
 #include "sim/flow_noise.hpp"
 #include "sim/leakage.hpp"
@@ -90,7 +92,7 @@ class Plant {
   void set_oil(const Oil& oil);
   double oil_temperature() const { return temperature_; }
   double viscosity_ratio() const { return c_.r; }
-  double supply_setpoint() const { return c_.ps0; }
+  double supply_setpoint() const { return c_.ps; }
 
   // Turns the mass ledger of PlantState on (costs two exp() per derivative evaluation).
   void enable_ledger(bool on) { ledger_ = on; }
@@ -103,31 +105,15 @@ class Plant {
  private:
   // The integrated state: PlantState's members in declaration order.
   using Vector = Eigen::Matrix<double, 10, 1>;
-  // Constants derived once from the parameters and effects, so the inner loop does no
-  // optional<> look-ups or repeated geometry.
-  struct Coefficients {
-    double A, V0, V_min, half_stroke, tau_spool, u_bias;
-    double overlap;  // 0 when valve_overlap is off
-    double ripple_dP, ripple_omega, droop_R_s;
-    int external_chamber;
-    double F_C;    // 0 when coulomb_friction is off
-    double alpha;  // 0 when entrained_air is off
-    double lag_tau_s;
-    bool lag_p1, lag_p2;
-    // Set by set_conditions(): viscosity ratio r, null leakage r C_n, viscous friction
-    // b (0.5 + 0.5/r), bulk modulus beta (1 - 0.003 (T - 40)), supply set-point ps0.
-    double r, C_n, b, beta, ps0;
-  };
-
   // step_midpoint: where a stepped leak schedule is read (see advance()).
   PlantFlows evaluate(double t, double step_midpoint, double xs, double p1, double p2,
                       double w) const noexcept;
-  void rates(double t, double u, const Vector& y, Vector& dy) noexcept;
+  void rates(double t, double spool_in, const Vector& y, Vector& dy) noexcept;
   void store(const Vector& y);
 
   Parameters params_;
   Effects effects_;
-  Coefficients c_;
+  ActuatorCoefficients c_;
   FlowNoise noise_;
   LeakSchedule leak_;
   LeakSchedule external_leak_;  // C_L holds C_E; empty when external_leakage is off

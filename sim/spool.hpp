@@ -6,9 +6,13 @@
 
 namespace leakmon::sim {
 
+// sat(u / u_max): the spool's normalised command, also the steady-state opening.
+inline double spool_command(double u_seen, double u_max) noexcept {
+  return std::clamp(u_seen / u_max, -1.0, 1.0);
+}
+
 inline double spool_rate(double u_seen, double xs, double u_max, double tau) noexcept {
-  const double command = std::clamp(u_seen / u_max, -1.0, 1.0);
-  return (command - xs) / tau;
+  return (spool_command(u_seen, u_max) - xs) / tau;
 }
 
 }  // namespace leakmon::sim

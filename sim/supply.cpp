@@ -8,13 +8,6 @@
 namespace leakmon::sim {
 namespace {
 
-// d orifice(dp) / d dp
-double orifice_slope(double dp, double dp_lin) noexcept {
-  const double magnitude = std::abs(dp);
-  if (magnitude >= dp_lin) return 0.5 / std::sqrt(magnitude);
-  return 1.0 / std::sqrt(dp_lin);
-}
-
 // The chamber the supply land feeds: 1 for o >= 0, 2 otherwise (valve.hpp).
 double fed_chamber_pressure(const SupplyInputs& in) { return in.opening >= 0.0 ? in.p1 : in.p2; }
 

@@ -3,7 +3,19 @@
 // the supply land's flow depends on the drooped pressure, so it is solved, not lagged.
 #pragma once
 
+#include <cmath>
+
 namespace leakmon::sim {
+
+// supply_ripple: ps0 + dP sin(omega t). The cos term (dQ) lets the model check fit the line's
+// phase; the simulator leaves it at 0.
+inline double rippled_supply(double ps0, double dP, double dQ, double omega, double t) noexcept {
+  if (dP == 0.0 && dQ == 0.0) return ps0;
+  const double phase = omega * t;
+  double ps = ps0 + dP * std::sin(phase);
+  if (dQ != 0.0) ps += dQ * std::cos(phase);
+  return ps;
+}
 
 struct SupplyInputs {
   double opening;  // effective spool opening o

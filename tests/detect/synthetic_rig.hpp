@@ -11,6 +11,7 @@
 #include "detect/detector.hpp"
 #include "detect/valve_flow.hpp"
 #include "sim/oil.hpp"
+#include "sim/parameters.hpp"
 
 namespace leakmon::test {
 
@@ -29,7 +30,7 @@ struct SyntheticRig {
   double overlap = 0.0;
   int crossing_hops = 0;
   double spring = 80e3, area = 6.334e-4;
-  detect::ValveGeometry valve;
+  sim::Parameters valve;  // the rig table: ps, pt, u_max, dp_lin
   // Drifting conditions (MODEL.md): oil temperature [degC] at time t (laminar leaks, the null
   // leakage included, follow the viscosity ratio; leak and null_leak are stated at 40 degC),
   // reported as Observation::temp when report_temp; the supply pressure at time t, reported as
@@ -65,31 +66,31 @@ struct SyntheticRig {
     const double r = oil.ratio(temp);
     const double leak_now = (t >= onset ? leak : 0.0) * r;
     const double dp = spring * x / area;
-    detect::ValveGeometry now = valve;
-    if (supply != nullptr) now.supply_pressure = supply(t);
-    const double p_mid = 0.5 * (now.supply_pressure + now.tank_pressure);
+    sim::Parameters now = valve;
+    if (supply != nullptr) now.ps = supply(t);
+    const double p_mid = 0.5 * (now.ps + now.pt);
     detect::Observation o;
     o.t = t;
     o.p1 = p_mid + dp / 2 + 2e3 * normal(rng);
     o.p2 = p_mid - dp / 2 + 2e3 * normal(rng);
     o.x = x + 2e-6 * normal(rng);
     if (report_temp) o.temp = temp + 0.05 * normal(rng);
-    if (report_supply) o.ps = now.supply_pressure + 5e3 * normal(rng);
+    if (report_supply) o.ps = now.ps + 5e3 * normal(rng);
     // Command whose load flow (valve_flow.hpp) feeds the leak, the null leak and the motion.
     const double flow = (leak_now + null_leak * r) * dp + area * (x - previous_x) / hop;
     const double per_opening = std::abs(detect::load_flow_per_kv(
-        now, std::copysign(now.command_full_scale, flow), p_mid + dp / 2, p_mid - dp / 2));
+        now, std::copysign(now.u_max, flow), p_mid + dp / 2, p_mid - dp / 2));
     const double opening = flow / (kv * per_opening);
     const bool arrived_across = x == target && previous_x != x && previous_x * x < 0.0;
     if (arrived_across) crossing_left = crossing_hops;
     const double spool = crossing_left > 0 ? 0.0 : opening + std::copysign(overlap, opening);
     if (crossing_left > 0) --crossing_left;
-    o.u = valve.command_full_scale * spool - command_offset + 1e-3 * normal(rng);
+    o.u = valve.u_max * spool - command_offset + 1e-3 * normal(rng);
     // Index: load-dependent level, AR(1) with about one window of memory, drop after onset.
     window_level = 0.95 * window_level + std::sqrt(1 - 0.95 * 0.95) * index_noise * normal(rng);
-    const double load = dp / valve.supply_pressure;
+    const double load = dp / valve.ps;
     const double drift = -index_friction_exponent * std::log(sim::friction_factor(r)) +
-                         0.5 * std::log(now.supply_pressure / valve.supply_pressure);
+                         0.5 * std::log(now.ps / valve.ps);
     const double log_index = std::log(30e3) - 0.8 * load * load + 0.1 * load + window_level +
                              drift + (t >= onset ? std::log1p(-index_drop) : 0.0);
     o.index_p1 = std::exp(log_index + 0.02 * normal(rng));
