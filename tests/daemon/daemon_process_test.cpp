@@ -23,18 +23,6 @@ namespace {
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
-  socklen_t length = sizeof(addr);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length);
-  ::close(fd);
-  return ntohs(addr.sin_port);
-}
-
 std::string config_text(const std::string& dir, int port, const std::string& alarm) {
   return "drivers: [{name: bench, type: replay, path: capture.csv}]\n"
          "actuators:\n"
@@ -74,7 +62,7 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   const capture::Capture capture = sim::simulate(scenario);
   capture::write_capture(dir + "/capture.csv", capture);
 
-  const int port = free_port();
+  const int port = test::free_port();
   const std::string cfg = dir + "/leakmon.yaml";
   write(cfg, config_text(dir, port, "{latching: true}"));
   test::DaemonProcess daemon({"run", "--config", cfg}, dir + "/daemon.log");

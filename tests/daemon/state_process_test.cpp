@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "daemon/http_endpoint.hpp"
 #include "capture/capture.hpp"
+#include "daemon/http_endpoint.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -20,18 +20,6 @@ namespace {
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
-
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
-  socklen_t length = sizeof(addr);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length);
-  ::close(fd);
-  return ntohs(addr.sin_port);
-}
 
 // Learning takes settle 1 s + learn 20 s; the restarts replay 3 s captures, too short to learn.
 std::string config_text(int port, int window) {
@@ -95,7 +83,7 @@ std::string show(const std::string& dir) {
 TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
   const std::string dir = test::scratch_dir("daemon_state_process");
   fs::remove_all(dir + "/state");
-  const int port = free_port();
+  const int port = test::free_port();
   std::ofstream(dir + "/leakmon.yaml") << config_text(port, 400);
 
   write_capture(dir, 31, 24.0);
@@ -151,7 +139,7 @@ TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
 TEST(DaemonStateProcess, LearnFromAKnownGoodCapture) {
   const std::string dir = test::scratch_dir("daemon_state_learn");
   fs::remove_all(dir + "/state");
-  std::ofstream(dir + "/leakmon.yaml") << config_text(free_port(), 400);
+  std::ofstream(dir + "/leakmon.yaml") << config_text(test::free_port(), 400);
   write_capture(dir, 41, 24.0);
   test::DaemonProcess learn(
       {"learn", "--config", dir + "/leakmon.yaml", "--in", dir + "/capture.csv"},
