@@ -129,6 +129,18 @@ void Daemon::start() {
   if (!config_.state.directory.empty()) {
     state_store_ = std::make_unique<StateStore>(config_.state.directory);
     worker_->restore_states(*state_store_);
+    // A file that fits the configuration is what the detector resumed from: its age is the
+    // learned state's until the next save.
+    const auto fingerprints = state_fingerprints(config_);
+    const auto listing = state_store_->list();
+    const std::lock_guard lock(state_saved_mutex_);
+    for (const auto& state : listing.states) {
+      for (const auto& [actuator, fingerprint] : fingerprints) {
+        if (actuator == state.actuator && fingerprint == state.fingerprint) {
+          state_saved_unix_[actuator] = state.saved_unix;
+        }
+      }
+    }
     spdlog::info("learned state kept under {} (saved every {} s and at shutdown)",
                  config_.state.directory, config_.state.save_seconds);
   }
@@ -190,6 +202,8 @@ void Daemon::save_state() {
   for (const auto& state : worker_->export_states()) {
     try {
       state_store_->save(state);
+      const std::lock_guard lock(state_saved_mutex_);
+      state_saved_unix_[state.actuator] = state.saved_unix;
     } catch (const std::exception& e) {
       spdlog::error("cannot save the learned state: {}", e.what());
       io::Event event;
@@ -223,6 +237,11 @@ void Daemon::stop() {
                worker_->samples_processed(), drops, worker_->events_published());
   worker_.reset();
   sinks_.clear();
+}
+
+std::map<std::string, double> Daemon::state_saved_unix() const {
+  const std::lock_guard lock(state_saved_mutex_);
+  return state_saved_unix_;
 }
 
 bool Daemon::all_sources_ended() const {

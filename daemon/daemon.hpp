@@ -8,7 +8,9 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -67,6 +69,8 @@ class Daemon {
   // Writes every actuator's learned state to the state directory (main thread; the worker is
   // locked only for the snapshot, the files are written outside it).
   void save_state();
+  // By actuator, when its learned state in the state directory was saved (for the metrics).
+  std::map<std::string, double> state_saved_unix() const;
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   HttpResponse handle(const HttpRequest& request);
@@ -81,6 +85,8 @@ class Daemon {
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;
+  mutable std::mutex state_saved_mutex_;  // the main thread saves, the metrics thread reads
+  std::map<std::string, double> state_saved_unix_;
   CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};

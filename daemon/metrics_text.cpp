@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -97,51 +99,19 @@ std::uint64_t flag(bool on) { return on ? 1 : 0; }
 
 }  // namespace
 
-std::string Daemon::metrics_text() const {
-  PrometheusText out;
-  out.family("leakmon_build_info", "leakmon version", "gauge");
-  out.sample("leakmon_build_info", label("version", LEAKMON_VERSION), std::uint64_t{1});
-
-  out.family("leakmon_loop_wakeup_latency_seconds", "acquisition loop wake-up minus schedule",
-             "histogram");
-  for (const auto& g : groups_) {
-    latency_histogram(out, "leakmon_loop_wakeup_latency_seconds", label("group", g->config.name),
-                      g->loop->counters().wakeup_latency);
+void state_set(PrometheusText& out, std::string_view name, std::string_view labels,
+               io::DeviceStatus current) {
+  const std::string_view sep = labels.empty() ? "" : ",";
+  for (const io::DeviceStatus status :
+       {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
+        io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
+    out.sample(name, fmt::format("{}{}{}", labels, sep, label("status", io::to_string(status))),
+               flag(current == status));
   }
-  auto per_group = [&](std::string_view name, std::string_view help, std::string_view type,
-                       auto value_of) {
-    out.family(name, help, type);
-    for (const auto& g : groups_) {
-      out.sample(name, label("group", g->config.name), static_cast<std::uint64_t>(value_of(*g)));
-    }
-  };
-  per_group("leakmon_loop_cycles_total", "acquisition cycles run", "counter",
-            [](const Group& g) { return g.loop->counters().cycles.load(); });
-  per_group("leakmon_loop_overruns_total", "late wake-ups that skipped a period", "counter",
-            [](const Group& g) { return g.loop->counters().overruns.load(); });
-  per_group("leakmon_loop_missed_cycles_total", "periods skipped by overruns", "counter",
-            [](const Group& g) { return g.loop->counters().missed_cycles.load(); });
-  per_group("leakmon_ring_drops_total", "samples dropped because the ring was full", "counter",
-            [](const Group& g) { return g.loop->counters().ring_drops.load(); });
-  per_group("leakmon_ring_high_water", "most samples ever queued in the ring", "gauge",
-            [](const Group& g) { return g.loop->counters().ring_high_water.load(); });
-  per_group("leakmon_ring_capacity", "ring capacity in samples", "gauge",
-            [](const Group& g) { return g.ring->capacity(); });
-  per_group("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
-            [](const Group& g) { return flag(g.realtime.fifo); });
+}
 
-  out.family("leakmon_cpu_wakeup_latency_request_held",
-             "1 while the CPU wake-up latency request (/dev/cpu_dma_latency) is held", "gauge");
-  out.sample("leakmon_cpu_wakeup_latency_request_held", "", flag(cpu_latency_.held()));
-  out.family("leakmon_samples_processed_total", "samples the worker consumed", "counter");
-  out.sample("leakmon_samples_processed_total", "", worker_->samples_processed());
-  out.family("leakmon_events_total", "events published", "counter");
-  out.sample("leakmon_events_total", "", worker_->events_published());
-  out.family("leakmon_decision_latency_seconds", "sample acquisition to decision and events",
-             "histogram");
-  latency_histogram(out, "leakmon_decision_latency_seconds", "", worker_->decision_latency());
-
-  const auto actuators = worker_->status();
+void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+                      const std::map<std::string, double>& state_saved_unix, double now_unix) {
   out.family("leakmon_index_pascal", "newest wavelet index (db8 level-2 detail RMS)", "gauge");
   for (const auto& a : actuators) {
     out.sample("leakmon_index_pascal", label("actuator", a.name) + "," + label("channel", "p1"),
@@ -194,14 +164,8 @@ std::string Daemon::metrics_text() const {
              "gauge");
   for (const auto& a : actuators) {
     for (const auto& c : a.channels) {
-      for (const io::DeviceStatus status :
-           {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
-            io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
-        out.sample("leakmon_sensor_status",
-                   label("actuator", a.name) + "," + label("channel", c.channel) + "," +
-                       label("status", io::to_string(status)),
-                   flag(c.status == status));
-      }
+      state_set(out, "leakmon_sensor_status",
+                label("actuator", a.name) + "," + label("channel", c.channel), c.status);
     }
   }
   out.family("leakmon_sensor_spikes_rejected_total", "isolated spikes replaced before the index",
@@ -217,6 +181,64 @@ std::string Daemon::metrics_text() const {
   for (const auto& a : actuators) {
     out.sample("leakmon_detector_suspended", label("actuator", a.name), flag(a.suspended));
   }
+  out.family("leakmon_learned_state_age_seconds",
+             "seconds since the learned state kept in the state directory was saved", "gauge");
+  for (const auto& a : actuators) {
+    const auto saved = state_saved_unix.find(a.name);
+    if (saved != state_saved_unix.end()) {
+      out.sample("leakmon_learned_state_age_seconds", label("actuator", a.name),
+                 std::max(0.0, now_unix - saved->second));
+    }
+  }
+}
+
+std::string Daemon::metrics_text() const {
+  PrometheusText out;
+  out.family("leakmon_build_info", "leakmon version", "gauge");
+  out.sample("leakmon_build_info", label("version", LEAKMON_VERSION), std::uint64_t{1});
+
+  out.family("leakmon_loop_wakeup_latency_seconds", "acquisition loop wake-up minus schedule",
+             "histogram");
+  for (const auto& g : groups_) {
+    latency_histogram(out, "leakmon_loop_wakeup_latency_seconds", label("group", g->config.name),
+                      g->loop->counters().wakeup_latency);
+  }
+  auto per_group = [&](std::string_view name, std::string_view help, std::string_view type,
+                       auto value_of) {
+    out.family(name, help, type);
+    for (const auto& g : groups_) {
+      out.sample(name, label("group", g->config.name), static_cast<std::uint64_t>(value_of(*g)));
+    }
+  };
+  per_group("leakmon_loop_cycles_total", "acquisition cycles run", "counter",
+            [](const Group& g) { return g.loop->counters().cycles.load(); });
+  per_group("leakmon_loop_overruns_total", "late wake-ups that skipped a period", "counter",
+            [](const Group& g) { return g.loop->counters().overruns.load(); });
+  per_group("leakmon_loop_missed_cycles_total", "periods skipped by overruns", "counter",
+            [](const Group& g) { return g.loop->counters().missed_cycles.load(); });
+  per_group("leakmon_ring_drops_total", "samples dropped because the ring was full", "counter",
+            [](const Group& g) { return g.loop->counters().ring_drops.load(); });
+  per_group("leakmon_ring_high_water", "most samples ever queued in the ring", "gauge",
+            [](const Group& g) { return g.loop->counters().ring_high_water.load(); });
+  per_group("leakmon_ring_capacity", "ring capacity in samples", "gauge",
+            [](const Group& g) { return g.ring->capacity(); });
+  per_group("leakmon_loop_realtime", "1 when the loop runs SCHED_FIFO", "gauge",
+            [](const Group& g) { return flag(g.realtime.fifo); });
+
+  out.family("leakmon_cpu_wakeup_latency_request_held",
+             "1 while the CPU wake-up latency request (/dev/cpu_dma_latency) is held", "gauge");
+  out.sample("leakmon_cpu_wakeup_latency_request_held", "", flag(cpu_latency_.held()));
+  out.family("leakmon_samples_processed_total", "samples the worker consumed", "counter");
+  out.sample("leakmon_samples_processed_total", "", worker_->samples_processed());
+  out.family("leakmon_events_total", "events published", "counter");
+  out.sample("leakmon_events_total", "", worker_->events_published());
+  out.family("leakmon_decision_latency_seconds", "sample acquisition to decision and events",
+             "histogram");
+  latency_histogram(out, "leakmon_decision_latency_seconds", "", worker_->decision_latency());
+
+  actuator_metrics(
+      out, worker_->status(), state_saved_unix(),
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
 
   std::vector<io::DriverHealth> health;
   for (const auto& d : drivers_) health.push_back(d->health());
@@ -231,17 +253,9 @@ std::string Daemon::metrics_text() const {
                label("driver", drivers_[i]->name()) + "," + label("state", health[i].detail),
                flag(health[i].status == io::DeviceStatus::ok));
   }
-  // A state set: one series per NE 107 category, 1 for the driver's current one.
   out.family("leakmon_driver_status", "driver health as NAMUR NE 107 category", "gauge");
   for (std::size_t i = 0; i < drivers_.size(); ++i) {
-    for (const io::DeviceStatus status :
-         {io::DeviceStatus::ok, io::DeviceStatus::failure, io::DeviceStatus::function_check,
-          io::DeviceStatus::out_of_specification, io::DeviceStatus::maintenance_required}) {
-      out.sample(
-          "leakmon_driver_status",
-          label("driver", drivers_[i]->name()) + "," + label("status", io::to_string(status)),
-          flag(health[i].status == status));
-    }
+    state_set(out, "leakmon_driver_status", label("driver", drivers_[i]->name()), health[i].status);
   }
   out.family("leakmon_driver_reconnects_total", "driver reconnects", "counter");
   for (std::size_t i = 0; i < drivers_.size(); ++i) {

@@ -5,9 +5,13 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <span>
 #include <string>
 #include <string_view>
+
+#include "daemon/actuator_monitor.hpp"
+#include "io/device_status.hpp"
 
 namespace leakmon::daemon {
 
@@ -44,5 +48,17 @@ class PrometheusText {
 
 // `name="value"` with the value escaped; join several with ",".
 std::string label(std::string_view name, std::string_view value);
+
+// A NAMUR NE 107 state set: one sample per category (`status` label), 1 for `current`, 0 for the
+// others, so that `== 1` selects the present category and a change is a change of series value.
+void state_set(PrometheusText& out, std::string_view name, std::string_view labels,
+               io::DeviceStatus current);
+
+// The per-actuator families of /metrics (index, score, alarm, leak size with its 95 % half-width,
+// oil temperature, sensor status, learned state age). `state_saved_unix`: by actuator, the wall
+// time [s since 1970] the learned state kept in the state directory was saved (an actuator
+// without an entry has no saved state and gets no age sample); `now_unix` the present wall time.
+void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+                      const std::map<std::string, double>& state_saved_unix, double now_unix);
 
 }  // namespace leakmon::daemon

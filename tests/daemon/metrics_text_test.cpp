@@ -1,5 +1,7 @@
 // The Prometheus text writer on its own: label escaping, histogram series and the exposition
-// layout (HELP, TYPE, then samples), without a daemon or a socket.
+// layout (HELP, TYPE, then samples), and the per-actuator families built from ActuatorStatus
+// values (leak size, oil temperature, sensor status, learned state age), without a daemon or a
+// socket.
 #include "daemon/metrics_text.hpp"
 
 #include <gtest/gtest.h>
@@ -175,6 +177,124 @@ TEST(MetricsText, ExpositionLinesHaveTheTextFormatShape) {
       const std::string kind = line.substr(end + 1);
       EXPECT_TRUE(kind == "counter" || kind == "gauge" || kind == "histogram") << line;
     } else {
+      EXPECT_TRUE(is_sample_line(line)) << line;
+    }
+  }
+}
+
+// The sample line of `name{labels}` in `text` without its value; "" when there is none.
+std::string value_of(const std::string& text, const std::string& series) {
+  for (const auto& line : lines_of(text)) {
+    if (line.size() > series.size() && line.compare(0, series.size(), series) == 0 &&
+        line[series.size()] == ' ') {
+      return line.substr(series.size() + 1);
+    }
+  }
+  return "";
+}
+
+std::size_t lines_starting(const std::string& text, std::string_view prefix) {
+  std::size_t n = 0;
+  for (const auto& line : lines_of(text)) n += line.rfind(prefix, 0) == 0 ? 1 : 0;
+  return n;
+}
+
+TEST(MetricsText, StateSetHasOneSeriesPerNe107CategoryWithOnlyTheCurrentOneSet) {
+  PrometheusText out;
+  state_set(out, "s", label("driver", "bus"), io::DeviceStatus::out_of_specification);
+  EXPECT_EQ(out.text(),
+            "s{driver=\"bus\",status=\"ok\"} 0\n"
+            "s{driver=\"bus\",status=\"failure\"} 0\n"
+            "s{driver=\"bus\",status=\"function_check\"} 0\n"
+            "s{driver=\"bus\",status=\"out_of_specification\"} 1\n"
+            "s{driver=\"bus\",status=\"maintenance_required\"} 0\n");
+  PrometheusText bare;
+  state_set(bare, "s", "", io::DeviceStatus::ok);
+  EXPECT_EQ(lines_of(bare.text()).front(), "s{status=\"ok\"} 1");
+}
+
+ActuatorStatus leaking_actuator() {
+  ActuatorStatus a;
+  a.name = "lift";
+  a.alarm = "internal_leakage";
+  a.detector = "default";
+  a.state = AlarmState::active_unacknowledged;
+  a.learning = false;
+  a.index_p1 = 1500.0;
+  a.index_p2 = 1250.0;
+  a.score = 7.5;
+  // 0.15 l/min/MPa = 0.15 / 60000 m^3/s per 1e6 Pa; the half-width 0.02 l/min/MPa.
+  a.leak_coefficient = 0.15 / 60000.0 / 1e6;
+  a.leak_coefficient_ci = 0.02 / 60000.0 / 1e6;
+  a.oil_temperature = 41.5;
+  a.channels = {{"p1", io::DeviceStatus::ok, detect::SensorFault::none, 0},
+                {"p2", io::DeviceStatus::failure, detect::SensorFault::none, 3}};
+  return a;
+}
+
+TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAge) {
+  ActuatorStatus fresh;  // a second actuator that has no estimate, temperature or saved state
+  fresh.name = "clamp";
+  fresh.alarm = "internal_leakage";
+  fresh.detector = "default";
+  fresh.channels = {{"p1", io::DeviceStatus::function_check, detect::SensorFault::none, 0}};
+  const std::vector<ActuatorStatus> actuators = {leaking_actuator(), fresh};
+  PrometheusText out;
+  actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
+  const std::string text = out.text();
+
+  EXPECT_NEAR(std::stod(value_of(text, "leakmon_leak_lpm_per_mpa{actuator=\"lift\"}")), 0.15,
+              1e-12);
+  EXPECT_NEAR(std::stod(value_of(text, "leakmon_leak_lpm_per_mpa_ci95{actuator=\"lift\"}")), 0.02,
+              1e-12);
+  EXPECT_EQ(value_of(text, "leakmon_leak_lpm_per_mpa{actuator=\"clamp\"}"), "NaN");
+  EXPECT_EQ(value_of(text, "leakmon_leak_lpm_per_mpa_ci95{actuator=\"clamp\"}"), "NaN");
+
+  EXPECT_EQ(value_of(text, "leakmon_oil_temperature_celsius{actuator=\"lift\"}"), "41.5");
+  EXPECT_EQ(lines_starting(text, "leakmon_oil_temperature_celsius{"), 1u);
+
+  EXPECT_EQ(value_of(text,
+                     "leakmon_sensor_status{actuator=\"lift\",channel=\"p2\",status="
+                     "\"failure\"}"),
+            "1");
+  EXPECT_EQ(value_of(text, "leakmon_sensor_status{actuator=\"lift\",channel=\"p2\",status=\"ok\"}"),
+            "0");
+  EXPECT_EQ(value_of(text,
+                     "leakmon_sensor_status{actuator=\"clamp\",channel=\"p1\",status="
+                     "\"function_check\"}"),
+            "1");
+  EXPECT_EQ(lines_starting(text, "leakmon_sensor_status{"), 3u * 5u);
+  EXPECT_EQ(
+      value_of(text, "leakmon_sensor_spikes_rejected_total{actuator=\"lift\",channel=\"p2\"}"),
+      "3");
+
+  EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "42.5");
+  // No saved state: no age sample (not a zero that would read as "just saved"); an actuator
+  // that is no longer configured is not reported either.
+  EXPECT_EQ(lines_starting(text, "leakmon_learned_state_age_seconds{"), 1u);
+
+  EXPECT_EQ(value_of(text,
+                     "leakmon_alarm_active{actuator=\"lift\",alarm=\"internal_leakage\","
+                     "state=\"active_unacknowledged\"}"),
+            "1");
+  EXPECT_EQ(value_of(text, "leakmon_index_pascal{actuator=\"lift\",channel=\"p2\"}"), "1250");
+  EXPECT_EQ(lines_starting(text, "leakmon_index_pascal{actuator=\"clamp\""), 1u);
+}
+
+TEST(MetricsText, ActuatorFamiliesHaveOneHeaderEachAndTheTextFormatShape) {
+  const std::vector<ActuatorStatus> actuators = {leaking_actuator()};
+  PrometheusText out;
+  actuator_metrics(out, actuators, {{"lift", 5.0}}, 4.0);  // a clock that stepped back
+  const std::string text = out.text();
+  EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "0");
+  for (const char* family : {"leakmon_leak_lpm_per_mpa", "leakmon_leak_lpm_per_mpa_ci95",
+                             "leakmon_oil_temperature_celsius", "leakmon_sensor_status",
+                             "leakmon_learned_state_age_seconds"}) {
+    EXPECT_EQ(lines_starting(text, std::string("# TYPE ") + family + " gauge"), 1u) << family;
+    EXPECT_EQ(lines_starting(text, std::string("# HELP ") + family + " "), 1u) << family;
+  }
+  for (const auto& line : lines_of(text)) {
+    if (line.rfind("# ", 0) != 0) {
       EXPECT_TRUE(is_sample_line(line)) << line;
     }
   }
