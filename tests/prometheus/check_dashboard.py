@@ -1,19 +1,24 @@
 #!/usr/bin/python3
 """Checks the Grafana dashboard (and the rules) against a live /metrics scrape of the daemon.
 
-check_dashboard.py DASHBOARD.json SCRAPE.txt [RULES.yml ...]
+check_dashboard.py [--promtool PROMTOOL] DASHBOARD.json SCRAPE.txt [RULES.yml ...]
 
 The dashboard must parse as JSON, take its Prometheus data source from a `datasource`
 template variable (so that it imports into any Grafana), and every PromQL expression in it
 (panel targets and template queries) may name only metrics present in SCRAPE (the daemon's
 exposition; histogram series by their _bucket/_sum/_count names). The gauges of issue 14
-must each be on some panel. Rule expressions may also name `up` (Prometheus' own series).
-Exits non-zero naming every problem.
+must each be on some panel; panel ids are unique and every panel lies in Grafana's 24-column
+grid. With --promtool, every expression (Grafana's variables replaced by values, label_values()
+by its selector) must parse as PromQL: they are handed to `promtool check rules` as recording
+rules. Rule expressions may also name `up` (Prometheus' own series). Exits non-zero naming
+every problem.
 """
 import json
 import pathlib
 import re
+import subprocess
 import sys
+import tempfile
 
 import yaml
 
@@ -94,8 +99,54 @@ def dashboard_exprs(dashboard):
         yield (where, expr), None
 
 
+def as_promql(expr):
+    """A Grafana expression as plain PromQL: variables given values, label_values() unwrapped."""
+    text = re.sub(r"\$__(rate_)?interval\b|\$\{__(rate_)?interval\}", "1m", expr)
+    text = re.sub(r"\$\{[^}]*\}|\$\w+", ".*", text)
+    return re.sub(r"^\s*label_values\s*\((.*),\s*[A-Za-z_]\w*\s*\)\s*$", r"\1", text)
+
+
+def promql_problems(promtool, exprs):
+    """What `promtool check rules` says about the expressions as recording rules."""
+    rules = {"groups": [{"name": "dashboard", "rules": [
+        {"record": f"dashboard:expr_{i}", "expr": as_promql(expr)}
+        for i, (_, expr) in enumerate(exprs)]}]}
+    with tempfile.NamedTemporaryFile("w", suffix=".yml") as file:
+        file.write(yaml.safe_dump(rules))
+        file.flush()
+        run = subprocess.run([promtool, "check", "rules", file.name], capture_output=True,
+                             text=True, timeout=50)
+    if run.returncode == 0:
+        return []
+    return [f"an expression does not parse as PromQL: {run.stdout + run.stderr}"]
+
+
+def layout_problems(dashboard):
+    problems, ids = [], set()
+
+    def walk(panels):
+        for panel in panels:
+            title, pos = panel.get("title"), panel.get("gridPos", {})
+            if panel.get("id") in ids:
+                problems.append(f"panel '{title}': id {panel.get('id')} used twice")
+            ids.add(panel.get("id"))
+            if not title:
+                problems.append(f"panel {panel.get('id')} has no title")
+            x, w, h = pos.get("x", -1), pos.get("w", 0), pos.get("h", 0)
+            if not (0 <= x and w > 0 and h > 0 and x + w <= 24 and pos.get("y", -1) >= 0):
+                problems.append(f"panel '{title}': gridPos {pos} is not in the 24-column grid")
+            walk(panel.get("panels", []))
+
+    walk(dashboard.get("panels", []))
+    return problems
+
+
 def main():
-    dashboard_path, scrape_path = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+    arguments = sys.argv[1:]
+    promtool = None
+    if arguments[:1] == ["--promtool"]:
+        promtool, arguments = arguments[1], arguments[2:]
+    dashboard_path, scrape_path = pathlib.Path(arguments[0]), pathlib.Path(arguments[1])
     emitted = scraped_names(scrape_path.read_text())
     problems = []
     if not any(name.startswith("leakmon_") for name in emitted):
@@ -105,17 +156,22 @@ def main():
     except json.JSONDecodeError as error:
         print(f"FAIL: {dashboard_path}: not JSON: {error}")
         return 1
+    if not dashboard.get("title"):
+        problems.append("the dashboard has no title")
+    problems += layout_problems(dashboard)
     variables = dashboard.get("templating", {}).get("list", [])
     if not any(v.get("name") == "datasource" and v.get("type") == "datasource"
                and v.get("query") == "prometheus" for v in variables):
         problems.append("no `datasource` template variable of type datasource (prometheus)")
     shown = set()
     count = 0
+    all_exprs = []
     for item, problem in dashboard_exprs(dashboard):
         if problem:
             problems.append(problem)
             continue
         where, expr = item
+        all_exprs.append(item)
         count += 1
         try:
             names = metric_names(expr)
@@ -130,11 +186,13 @@ def main():
                 problems.append(f"{where}: {name} is not emitted by the daemon (`{expr}`)")
     if count == 0:
         problems.append("the dashboard has no PromQL expression")
+    elif promtool:
+        problems += promql_problems(promtool, all_exprs)
     for name in REQUIRED_ON_DASHBOARD:
         if name not in shown:
             problems.append(f"no panel shows {name}")
 
-    for rules_path in map(pathlib.Path, sys.argv[3:]):
+    for rules_path in map(pathlib.Path, arguments[2:]):
         for group in yaml.safe_load(rules_path.read_text())["groups"]:
             for rule in group["rules"]:
                 where = f"{rules_path.name}: {rule.get('alert') or rule.get('record')}"

@@ -134,8 +134,8 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
   EXPECT_NE(bad_lint.output.find("_total"), std::string::npos) << bad_lint.output;
 
   const std::string source = test::source_dir();
-  const std::string checker =
-      test::python() + " " + source + "/tests/prometheus/check_dashboard.py ";
+  const std::string checker = test::python() + " " + source +
+                              "/tests/prometheus/check_dashboard.py --promtool " + promtool + " ";
   const std::string rules = " " + source + "/prometheus/leakmon-alert-rules.yml " + source +
                             "/prometheus/leakmon-recording-rules.yml";
   const CommandResult dashboard = run_command(
@@ -152,6 +152,17 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
   EXPECT_NE(misspelt.status, 0) << misspelt.output;
   EXPECT_NE(misspelt.output.find("leakmon_oil_temp_c is not emitted"), std::string::npos)
       << misspelt.output;
+  // So is one whose expression does not parse as PromQL (an unclosed parenthesis).
+  json = test::DaemonProcess::read_file(source + "/prometheus/grafana/leakmon-dashboard.json");
+  const std::string closed = "(leakmon_driver_up{instance=~\\\"$instance\\\"})";
+  const auto paren = json.find(closed);
+  ASSERT_NE(paren, std::string::npos);
+  json.erase(paren + closed.size() - 1, 1);
+  write(dir + "/unparsable.json", json);
+  const CommandResult unparsable = run_command(checker + dir + "/unparsable.json " + scrape_path);
+  EXPECT_NE(unparsable.status, 0) << unparsable.output;
+  EXPECT_NE(unparsable.output.find("unclosed left parenthesis"), std::string::npos)
+      << unparsable.output;
 
   daemon.signal(SIGTERM);
   EXPECT_EQ(daemon.wait(20s), 0) << daemon.log();
