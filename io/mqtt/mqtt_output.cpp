@@ -276,8 +276,8 @@ class MqttOutput final : public EventSink {
                        settings_.queue_directory);
         }
         if (!queue_->empty()) {
-          spdlog::info("mqtt output {}: {} event(s) from before the restart wait in {}",
-                       settings_.name, queue_->events(), settings_.queue_directory);
+          spdlog::info("mqtt output {}: {} event(s) queued earlier wait in {}", settings_.name,
+                       queue_->events(), settings_.queue_directory);
         }
         queue_error_.clear();
       } catch (const DiskQueueBusy&) {
