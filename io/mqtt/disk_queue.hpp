@@ -1,6 +1,7 @@
 // The MQTT output's durable queue of events not yet acknowledged by the broker: append-only
 // segment files in one directory, every append fsync'd before it counts, a message removed only
-// after its PUBACK (an acknowledgement cursor, rewritten atomically). Survives a restart or a
+// after its PUBACK (an acknowledgement cursor, replaced by rename and not synced: after a
+// power cut it may lag, and messages go out twice rather than never). Survives a restart or a
 // crash; a torn last record (power cut mid-write) is cut off when the queue is opened.
 //
 // Layout of `directory`: `lock` (flock: one queue user at a time), `acked` (the sequence number
@@ -57,7 +58,7 @@ class DiskQueue {
 
   bool empty() const { return pending_.empty(); }
   const QueuedMessage& front() const { return pending_.front(); }
-  // The oldest message was acknowledged: the cursor moves past it (durably) and segments that
+  // The oldest message was acknowledged: the cursor moves past it and segments that
   // hold only acknowledged messages go.
   void pop_front();
 
