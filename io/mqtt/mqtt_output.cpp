@@ -211,7 +211,8 @@ class MqttOutput final : public EventSink {
          connected_.load(std::memory_order_relaxed) ? 1.0 : 0.0},
         {"mqtt_queue_events", "events waiting in the on-disk queue for the broker's PUBACK", false,
          load(queue_events_)},
-        {"mqtt_queue_bytes", "bytes of those events", false, load(queue_bytes_)},
+        {"mqtt_queue_bytes", "bytes of the events waiting in the on-disk queue", false,
+         load(queue_bytes_)},
         {"mqtt_queue_max_events", "the queue's bound in events", false,
          static_cast<double>(settings_.queue_limits.max_events)},
         {"mqtt_events_published_total", "events the broker acknowledged (PUBACK)", true,
@@ -238,7 +239,9 @@ class MqttOutput final : public EventSink {
 
   void run() {
     init_library_once();
-    auto next_features = Clock::now();
+    const auto feature_period = std::chrono::nanoseconds(
+        static_cast<std::int64_t>(1e9 / std::max(settings_.features_hz, 1e-3)));
+    auto next_features = Clock::now() + feature_period;  // the first connection has a moment
     while (true) {
       bool stopping = false;
       {
@@ -255,8 +258,7 @@ class MqttOutput final : public EventSink {
       if (connected_ && queue_) send_next_event();
       if (settings_.features_hz > 0 && Clock::now() >= next_features) {
         sample_features();
-        next_features +=
-            std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / settings_.features_hz));
+        next_features += feature_period;
         if (next_features < Clock::now()) next_features = Clock::now();
       }
       update_gauges();
@@ -377,6 +379,15 @@ class MqttOutput final : public EventSink {
                                    : fmt::format("cannot connect: {}", why));
       return;
     }
+    if (birth_pending_) {
+      birth_pending_ = false;
+      const int birth =
+          mosquitto_publish(mosq_, nullptr, status_topic_.c_str(), 6, "online", 1, true);
+      if (birth != MOSQ_ERR_SUCCESS) {
+        connection_failed(fmt::format("cannot publish the birth message: {}", error_text(birth)));
+        return;
+      }
+    }
     if (!connected_ && Clock::now() - attempt_started_ >
                            std::chrono::duration<double>(settings_.connect_timeout_s)) {
       connection_failed(
@@ -394,12 +405,9 @@ class MqttOutput final : public EventSink {
     connected_ = true;
     backoff_ = 250ms;
     inflight_mid_.reset();
-    const int birth =
-        mosquitto_publish(mosq_, nullptr, status_topic_.c_str(), 6, "online", 1, true);
-    if (birth != MOSQ_ERR_SUCCESS) {
-      spdlog::warn("mqtt output {}: cannot publish the birth message: {}", settings_.name,
-                   error_text(birth));
-    }
+    // Published after the loop returns: libmosquitto holds its callback lock here, and
+    // publishing under it inverts the library's lock order.
+    birth_pending_ = true;
     if (!last_error_.empty() || !ever_connected_) {
       spdlog::info("mqtt output {}: connected to {}:{} as {}, publishing under {}/", settings_.name,
                    settings_.host, settings_.port, settings_.client_id, settings_.topic);
@@ -497,6 +505,7 @@ class MqttOutput final : public EventSink {
     if (mosq_ != nullptr) mosquitto_destroy(mosq_);
     mosq_ = nullptr;
     connected_ = false;
+    birth_pending_ = false;
     inflight_mid_.reset();
   }
 
@@ -589,6 +598,7 @@ class MqttOutput final : public EventSink {
   std::string refused_;
   std::string library_error_;
   bool ever_connected_ = false;
+  bool birth_pending_ = false;
 };
 
 }  // namespace
