@@ -255,7 +255,7 @@ class MqttOutput final : public EventSink {
       if (stopping) break;
       if (!mosq_ && Clock::now() >= next_attempt_) connect();
       if (mosq_) service();
-      if (connected_ && queue_) send_next_event();
+      if (connected_ && queue_ && mosq_) send_next_event();
       if (settings_.features_hz > 0 && Clock::now() >= next_features) {
         sample_features();
         next_features += feature_period;
@@ -430,6 +430,13 @@ class MqttOutput final : public EventSink {
   }
 
   void send_next_event() {
+    // A broker that took the connection but never acknowledges (overloaded, stuck) is left
+    // like a lost one: reconnect and publish the head again.
+    if (inflight_mid_ &&
+        Clock::now() - inflight_since_ > std::chrono::seconds(settings_.keepalive_s)) {
+      connection_failed(fmt::format("no PUBACK within {} s", settings_.keepalive_s));
+      return;
+    }
     if (inflight_mid_ || queue_->empty()) return;
     const QueuedMessage& next = queue_->front();
     int mid = 0;
@@ -438,6 +445,7 @@ class MqttOutput final : public EventSink {
                           next.payload.data(), 1, false);
     if (rc == MOSQ_ERR_SUCCESS) {
       inflight_mid_ = mid;
+      inflight_since_ = Clock::now();
     } else {
       connection_failed(fmt::format("cannot publish: {}", error_text(rc)));
     }
@@ -593,6 +601,7 @@ class MqttOutput final : public EventSink {
   Clock::time_point next_attempt_{};
   std::chrono::nanoseconds backoff_ = 250ms;
   std::optional<int> inflight_mid_;
+  Clock::time_point inflight_since_{};
   std::optional<int> offline_mid_;
   std::string last_error_;
   std::string refused_;
