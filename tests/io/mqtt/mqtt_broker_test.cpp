@@ -325,5 +325,20 @@ TEST(MqttBroker, RefusedCredentialsAndTlsFailuresAreClearErrors) {
   EXPECT_EQ(metric(metrics_port, "leakmon_mqtt_connected{output=\"tls\"}"), 0.0);
 }
 
+TEST(MqttBroker, CheckConfigNamesTheMqttFieldAtFileLineColumn) {
+  const std::string dir = scratch_dir("mqtt_check_config");
+  write_file(dir + "/leakmon.yaml",
+             daemon_config(0, 2, mqtt_output("fleet", 1883, ", tls: {ca_file: missing.crt}")));
+  DaemonProcess check({"check-config", dir + "/leakmon.yaml"}, dir + "/check.log");
+  EXPECT_EQ(check.wait(20s), 1);
+  const std::string out = check.log();
+  EXPECT_NE(out.find(dir + "/leakmon.yaml:"), std::string::npos) << out;
+  EXPECT_NE(out.find("outputs[0].tls.ca_file: file '" + dir + "/missing.crt' does not exist"),
+            std::string::npos)
+      << out;
+  // Checking never connects: no queue directory appears.
+  EXPECT_FALSE(std::filesystem::exists(dir + "/queue-fleet"));
+}
+
 }  // namespace
 }  // namespace leakmon::test
