@@ -75,6 +75,25 @@ std::vector<io::EventSink*> Daemon::raw(const std::vector<std::unique_ptr<io::Ev
   return out;
 }
 
+void Daemon::attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& sinks,
+                             bool attach) const {
+  io::ReadingSource source;
+  if (attach) {
+    const Worker* worker = worker_.get();
+    source = [worker] {
+      constexpr double kLpmPerMpa = 60000.0 * 1e6;  // m^3/(s Pa) -> l/min/MPa
+      std::vector<io::ActuatorReading> readings;
+      for (const auto& a : worker->status()) {
+        readings.push_back({a.name, a.t, a.index_p1, a.score, a.leak_coefficient * kLpmPerMpa,
+                            a.leak_coefficient_ci * kLpmPerMpa, std::string(to_string(a.state)),
+                            a.learning});
+      }
+      return readings;
+    };
+  }
+  for (const auto& sink : sinks) sink->attach_readings(source);
+}
+
 void Daemon::start() {
   config_ = check_config(config_path_);
   spdlog::info("configuration {}: {} driver(s), {} sampling group(s), {} actuator(s)", config_path_,
@@ -125,6 +144,7 @@ void Daemon::start() {
   reported_overruns_.assign(groups_.size(), 0);
   sinks_ = build_sinks(config_);
   worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
+  attach_readings(sinks_, true);
   // What was learned before a restart comes back before the first sample is acquired.
   if (!config_.state.directory.empty()) {
     state_store_ = std::make_unique<StateStore>(config_.state.directory);
@@ -228,6 +248,7 @@ void Daemon::stop() {
   save_state();
   worker_->flush();
   endpoint_.reset();
+  attach_readings(sinks_, false);
   std::uint64_t pushed = 0, drops = 0;
   for (const auto& group : groups_) {
     pushed += group->loop->counters().samples_pushed.load();
@@ -236,6 +257,7 @@ void Daemon::stop() {
   spdlog::info("stopped: {} samples acquired, {} processed, {} dropped, {} events", pushed,
                worker_->samples_processed(), drops, worker_->events_published());
   worker_.reset();
+  std::lock_guard lock(sinks_mutex_);
   sinks_.clear();
 }
 
@@ -329,8 +351,12 @@ void Daemon::reload() {
           config_path_));
     }
     auto sinks = build_sinks(next);
+    attach_readings(sinks, true);
     worker_->apply(next, raw(sinks));
-    sinks_.swap(sinks);  // the old sinks go only after the worker stopped using them
+    {
+      std::lock_guard lock(sinks_mutex_);
+      sinks_.swap(sinks);  // the old sinks go only after the worker stopped using them
+    }
     config_ = std::move(next);
     ++reloads_;
     last_reload_ok_ = true;

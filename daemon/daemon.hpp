@@ -64,6 +64,9 @@ class Daemon {
   void stop();
   std::vector<std::unique_ptr<io::EventSink>> build_sinks(const DaemonConfig& config) const;
   static std::vector<io::EventSink*> raw(const std::vector<std::unique_ptr<io::EventSink>>& sinks);
+  // Outputs that publish live values (e.g. MQTT features) sample the worker's status snapshot
+  // from their own threads; detached (empty source) before the worker goes.
+  void attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& sinks, bool attach) const;
   void reload();
   void housekeeping(std::int64_t now_ns);
   // Writes every actuator's learned state to the state directory (main thread; the worker is
@@ -80,6 +83,7 @@ class Daemon {
   std::vector<std::unique_ptr<io::Driver>> drivers_;
   std::vector<std::unique_ptr<Group>> groups_;
   std::vector<std::unique_ptr<io::EventSink>> sinks_;
+  mutable std::mutex sinks_mutex_;  // a reload swaps sinks_ while /metrics reads them
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<HttpEndpoint> endpoint_;

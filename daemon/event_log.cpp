@@ -12,98 +12,6 @@
 #include <stdexcept>
 
 namespace leakmon::daemon {
-namespace {
-
-void append_json_string(std::string& out, std::string_view text) {
-  out += '"';
-  for (char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-}
-
-class JsonObject {
- public:
-  void string(std::string_view key, std::string_view value) {
-    if (value.empty()) return;
-    key_(key);
-    append_json_string(text_, value);
-  }
-  void number(std::string_view key, double value) {
-    if (!std::isfinite(value)) return;
-    key_(key);
-    text_ += fmt::format("{}", value);
-  }
-  void boolean(std::string_view key, bool value) {
-    key_(key);
-    text_ += value ? "true" : "false";
-  }
-  std::string finish() { return text_ + "}"; }
-
- private:
-  void key_(std::string_view key) {
-    text_ += text_.size() > 1 ? ", " : "";
-    append_json_string(text_, key);
-    text_ += ": ";
-  }
-  std::string text_ = "{";
-};
-
-bool is_alarm(io::EventKind kind) {
-  return kind == io::EventKind::alarm_raised || kind == io::EventKind::alarm_cleared ||
-         kind == io::EventKind::alarm_acknowledged;
-}
-
-}  // namespace
-
-std::string to_json_line(const io::Event& event) {
-  JsonObject json;
-  json.number("t", event.t);
-  json.string("event", to_string(event.kind));
-  json.string("actuator", event.actuator);
-  json.string("alarm", event.alarm);
-  json.string("channel", event.channel);
-  json.string("fault", event.fault);
-  json.number("index", event.index / 1e3);
-  json.number("score", event.score);
-  json.number("baseline", event.baseline / 1e3);
-  json.number("leak_coefficient", event.leak_coefficient);
-  json.number("leak_lpm_per_mpa", event.leak_lpm_per_mpa);
-  json.number("leak_lpm", event.leak_lpm);
-  json.number("leak_lpm_per_mpa_ci95", event.leak_lpm_per_mpa_ci95);
-  json.number("leak_lpm_ci95", event.leak_lpm_ci95);
-  json.number("load_pressure_mpa", event.load_pressure / 1e6);
-  if (is_alarm(event.kind)) json.boolean("latched", event.latched);
-  json.string("message", event.message);
-  if (std::isfinite(event.unix_time)) {
-    const auto seconds = static_cast<std::time_t>(event.unix_time);
-    const auto millis = static_cast<int>((event.unix_time - static_cast<double>(seconds)) * 1e3);
-    json.string("time", fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z", fmt::gmtime(seconds), millis));
-  }
-  return json.finish();
-}
 
 std::string to_log_line(const io::Event& event) {
   std::string line(to_string(event.kind));
@@ -151,7 +59,8 @@ void LogEventSink::publish(const io::Event& event) {
   const auto level =
       (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
        event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected ||
-       event.kind == io::EventKind::state_discarded || event.kind == io::EventKind::state_save_failed)
+       event.kind == io::EventKind::state_discarded ||
+       event.kind == io::EventKind::state_save_failed)
           ? spdlog::level::warn
           : spdlog::level::info;
   spdlog::log(level, "{}", to_log_line(event));

@@ -9,12 +9,12 @@
 
 #include "config/yaml_reader.hpp"
 #include "io/event.hpp"
+#include "io/event_json.hpp"
 
 namespace leakmon::daemon {
 
-// One JSON object, no trailing newline. Fields that are NaN or empty are left out. `index` is
-// in kPa (as FORMATS.md shows it); leak sizes in l/min/MPa and l/min.
-std::string to_json_line(const io::Event& event);
+// The event log's JSON line (io/event_json.hpp, shared with the MQTT output).
+using io::to_json_line;
 // The one-line operator message for the log.
 std::string to_log_line(const io::Event& event);
 

@@ -279,6 +279,25 @@ std::string Daemon::metrics_text() const {
   out.family("leakmon_config_last_reload_timestamp_seconds", "unix time of the last reload attempt",
              "gauge");
   out.sample("leakmon_config_last_reload_timestamp_seconds", "", last_reload_unix_.load());
+
+  // Outputs' own counters (io::EventSink::metrics), one family per name across outputs.
+  std::vector<std::pair<std::string, io::SinkMetric>> sink_metrics;
+  {
+    std::lock_guard lock(sinks_mutex_);
+    for (const auto& sink : sinks_) {
+      for (const auto& metric : sink->metrics())
+        sink_metrics.emplace_back(std::string(sink->name()), metric);
+    }
+  }
+  std::stable_sort(sink_metrics.begin(), sink_metrics.end(),
+                   [](const auto& a, const auto& b) { return a.second.name < b.second.name; });
+  for (std::size_t i = 0; i < sink_metrics.size(); ++i) {
+    const auto& [output, metric] = sink_metrics[i];
+    const std::string name = fmt::format("leakmon_{}", metric.name);
+    if (i == 0 || sink_metrics[i - 1].second.name != metric.name)
+      out.family(name, metric.help, metric.counter ? "counter" : "gauge");
+    out.sample(name, label("output", output), metric.value);
+  }
   return out.take();
 }
 

@@ -2,6 +2,7 @@
 
 #include "daemon/event_log.hpp"
 #include "io/modbus/modbus_output.hpp"
+#include "io/mqtt/mqtt_output.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -9,6 +10,7 @@ namespace {
 constexpr OutputType kOutputTypes[] = {
     {"jsonl", make_jsonl_output},
     {"modbus", io::make_modbus_output},
+    {"mqtt", io::mqtt::make_mqtt_output},
 };
 
 }  // namespace

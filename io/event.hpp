@@ -6,9 +6,12 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace leakmon::io {
 
@@ -85,6 +88,30 @@ struct Event {
   bool latched = false;         // alarm events: the alarm waits for acknowledgement
 };
 
+// One actuator's newest decision as an output may sample it (the snapshot /metrics reads).
+struct ActuatorReading {
+  std::string actuator;
+  double t = kNoValue;      // source time of the decision [s]
+  double index = kNoValue;  // [Pa], the p1 channel's
+  double score = kNoValue;
+  double leak_lpm_per_mpa = kNoValue;  // at 40 degC when the oil temperature is known
+  double leak_lpm_per_mpa_ci95 = kNoValue;
+  std::string alarm_state;  // normal, raised, ... (daemon/alarm.hpp)
+  bool learning = true;
+};
+// Called from the output's own thread; takes the worker's lock briefly, never the real-time
+// path's. Empty when the daemon offers none.
+using ReadingSource = std::function<std::vector<ActuatorReading>()>;
+
+// A number an output counts, for the daemon's /metrics (`leakmon_` + name, labelled with the
+// output's name).
+struct SinkMetric {
+  std::string_view name;  // e.g. "mqtt_connected"
+  std::string_view help;
+  bool counter = false;  // else a gauge
+  double value = 0.0;
+};
+
 // Receives every event, in order, on the worker thread (never the real-time thread). publish()
 // must not block for long: a sink that talks to slow devices queues and writes elsewhere.
 class EventSink {
@@ -97,6 +124,13 @@ class EventSink {
   virtual void publish(const Event& event) = 0;
   // Make everything published so far durable (called at least once a second and at shutdown).
   virtual void flush() {}
+
+  // Optional hooks, unused by most sinks. attach_readings: a source of live values the sink may
+  // call from its own thread until it is detached (called with an empty source, which waits for
+  // a call in progress). metrics: the sink's own counters, read from the metrics thread.
+  virtual void attach_readings(ReadingSource source) { (void)source; }
+  virtual std::string_view name() const { return {}; }
+  virtual std::vector<SinkMetric> metrics() const { return {}; }
 };
 
 }  // namespace leakmon::io

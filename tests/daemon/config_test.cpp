@@ -148,8 +148,8 @@ TEST(DaemonConfig, CheckConfigFindsMissingChannelsAndBadDriverTypes) {
 }
 
 TEST(DaemonConfig, ShippedExamplesAreValid) {
-  for (const char* file :
-       {"/config/demo.yaml", "/io/sim/sim.yaml", "/bench/daemon/rss_8_channels.yaml"}) {
+  for (const char* file : {"/config/demo.yaml", "/io/sim/sim.yaml",
+                           "/bench/daemon/rss_8_channels.yaml", "/io/mqtt/mqtt.yaml"}) {
     EXPECT_NO_THROW(check_config(test::source_dir() + file)) << file;
   }
   // The replay sample names a capture that only exists on a rig: parse it, do not build it.

@@ -1,0 +1,99 @@
+#include "io/event_json.hpp"
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <ctime>
+
+namespace leakmon::io {
+namespace {
+
+void append_json_string(std::string& out, std::string_view text) {
+  out += '"';
+  for (char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+
+bool is_alarm(EventKind kind) {
+  return kind == EventKind::alarm_raised || kind == EventKind::alarm_cleared ||
+         kind == EventKind::alarm_acknowledged;
+}
+
+}  // namespace
+
+void JsonObject::string(std::string_view key_name, std::string_view value) {
+  if (value.empty()) return;
+  key(key_name);
+  append_json_string(text_, value);
+}
+
+void JsonObject::number(std::string_view key_name, double value) {
+  if (!std::isfinite(value)) return;
+  key(key_name);
+  text_ += fmt::format("{}", value);
+}
+
+void JsonObject::boolean(std::string_view key_name, bool value) {
+  key(key_name);
+  text_ += value ? "true" : "false";
+}
+
+void JsonObject::key(std::string_view key_name) {
+  text_ += text_.size() > 1 ? ", " : "";
+  append_json_string(text_, key_name);
+  text_ += ": ";
+}
+
+std::string to_json_line(const Event& event) {
+  JsonObject json;
+  json.number("t", event.t);
+  json.string("event", to_string(event.kind));
+  json.string("actuator", event.actuator);
+  json.string("alarm", event.alarm);
+  json.string("channel", event.channel);
+  json.string("fault", event.fault);
+  json.number("index", event.index / 1e3);
+  json.number("score", event.score);
+  json.number("baseline", event.baseline / 1e3);
+  json.number("leak_coefficient", event.leak_coefficient);
+  json.number("leak_lpm_per_mpa", event.leak_lpm_per_mpa);
+  json.number("leak_lpm", event.leak_lpm);
+  json.number("leak_lpm_per_mpa_ci95", event.leak_lpm_per_mpa_ci95);
+  json.number("leak_lpm_ci95", event.leak_lpm_ci95);
+  json.number("load_pressure_mpa", event.load_pressure / 1e6);
+  if (is_alarm(event.kind)) json.boolean("latched", event.latched);
+  json.string("message", event.message);
+  if (std::isfinite(event.unix_time)) {
+    const auto seconds = static_cast<std::time_t>(event.unix_time);
+    const auto millis = static_cast<int>((event.unix_time - static_cast<double>(seconds)) * 1e3);
+    json.string("time", fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z", fmt::gmtime(seconds), millis));
+  }
+  return json.finish();
+}
+
+}  // namespace leakmon::io

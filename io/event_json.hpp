@@ -1,0 +1,29 @@
+// An event as one JSON object: the line of the JSON-lines event log (FORMATS.md `leakmon
+// replay` lines) and the payload of the MQTT output, so both carry the very same text.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "io/event.hpp"
+
+namespace leakmon::io {
+
+// One JSON object, no trailing newline. Fields that are NaN or empty are left out. `index` is
+// in kPa (as FORMATS.md shows it); leak sizes in l/min/MPa and l/min.
+std::string to_json_line(const Event& event);
+
+// Builds a flat JSON object: strings escaped, empty strings and non-finite numbers left out.
+class JsonObject {
+ public:
+  void string(std::string_view key, std::string_view value);
+  void number(std::string_view key, double value);
+  void boolean(std::string_view key, bool value);
+  std::string finish() { return text_ + "}"; }
+
+ private:
+  void key(std::string_view key);
+  std::string text_ = "{";
+};
+
+}  // namespace leakmon::io
