@@ -4,8 +4,14 @@
 // the configured token. The page in a browser: live_page_test.py.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <thread>
+
+#include <fmt/format.h>
 
 #include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
@@ -151,6 +157,74 @@ TEST(OperatorView, SamplingTheWorkerAllocatesNothing) {
   EXPECT_EQ(response->status, 200);
   EXPECT_EQ(response->content_type.rfind("application/json", 0), 0u);
   EXPECT_EQ(view.handle({"GET", "/api/trend", "since=yesterday"})->status, 400);
+}
+
+// The sampler thread writes while HTTP readers read (run under TSan: label `threads`).
+TEST(OperatorView, SamplerThreadAndReadersShareTheHistorySafely) {
+  DaemonConfig config;
+  config.metrics.trend_interval_s = 0.01;
+  config.metrics.trend_seconds = 60.0;
+  std::atomic<int> calls{0};
+  {
+    OperatorView view(config, {"main"});
+    auto sink = view.event_sink();
+    view.start_sampling([&](ViewSnapshot& out) {
+      if (out.actuators.empty()) out = snapshot_of("cyl", 0.5, AlarmState::normal);
+      out.actuators[0].score = calls.fetch_add(1);
+    });
+    std::thread publisher([&] {
+      for (int i = 0; i < 200; ++i) {
+        io::Event event;
+        event.kind = io::EventKind::overrun;
+        sink->publish(event);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+    std::size_t answers = 0;
+    while (calls.load() < 20) {
+      answers += view.handle({"GET", "/api/trend", "since=0"})->body.size() > 0 ? 1 : 0;
+      answers += view.handle({"GET", "/api/events", "after=3"})->body.size() > 0 ? 1 : 0;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    publisher.join();
+    EXPECT_GT(answers, 0u);
+    const std::string trend = view.trend_json(0.0);
+    EXPECT_NE(trend.find("\"name\":\"cyl\""), std::string::npos);
+  }  // the view stops its sampler
+  const int after_stop = calls.load();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(calls.load(), after_stop) << "the sampler outlived the view";
+}
+
+// What a browser loads when it opens the page on a full default history (4 h at 1 s): the
+// size of the first /api/trend answer, printed with the time it took (not asserted).
+TEST(OperatorView, FullDefaultHistoryAnswer) {
+  DaemonConfig config;
+  ActuatorConfig actuator;
+  actuator.name = "cyl";
+  config.actuators.push_back(actuator);
+  OperatorView view(config, {"main"});
+  ViewSnapshot source = snapshot_of("cyl", 0.5, AlarmState::normal);
+  int i = 0;
+  view.set_source([&](ViewSnapshot& out) {
+    source.actuators[0].score = 0.3 + 1e-4 * (i % 1000);
+    source.actuators[0].index_p1 = 21345.678 + i % 977;
+    source.actuators[0].index_p2 = 23456.789 + i % 911;
+    source.actuators[0].p1 = 6.5e6 + 1234.5 * (i % 100);
+    source.actuators[0].p2 = 10.8e6 - 1234.5 * (i % 100);
+    out = source;
+  });
+  const std::size_t capacity = trend_capacity(config.metrics.trend_seconds, 1.0);
+  for (; i < static_cast<int>(capacity) + 10; ++i) view.sample(1.8e9 + i);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string json = view.trend_json(0.0);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("full history: %zu points, /api/trend?since=0 is %.2f MB, built in %.1f ms\n",
+              capacity, static_cast<double>(json.size()) / 1e6, ms);
+  EXPECT_NE(json.find("\"time\":[1800000010.000,"), std::string::npos) << "oldest points dropped";
+  EXPECT_NE(json.find(fmt::format("{:.3f}]", 1.8e9 + capacity + 9)), std::string::npos);
+  EXPECT_LT(json.size(), 5'000'000u);
 }
 
 TEST(OperatorView, ServesThePageAndItsAssetsFromTheBinary) {
