@@ -421,7 +421,9 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
     }
     return json_response(events_->json_after(value));
   }
-  const std::string_view path = request.path == "/index.html" ? "/" : request.path;
+  // Both arms string_view: a std::string arm would make a temporary the view outlives.
+  const std::string_view path =
+      request.path == "/index.html" ? std::string_view("/") : std::string_view(request.path);
   for (const auto& asset : web_assets()) {
     if (asset.path == path) {
       return HttpResponse{200, std::string(asset.content_type), std::string(asset.body)};

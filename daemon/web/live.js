@@ -329,6 +329,10 @@ $("window").addEventListener("change", () => {
     const range = windowRange(entry.data.time);
     if (range) for (const c of entry.charts) c.chart.setScale("x", range);
   }
+  if (view.loop) {
+    const range = windowRange(view.loop.data.time);
+    if (range) view.loop.chart.chart.setScale("x", range);
+  }
 });
 pollTrend();
 pollEvents();
