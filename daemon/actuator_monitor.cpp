@@ -228,6 +228,8 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   hop_samples_ = 0;
   last_t_ = t;
   if (!std::isnan(observation.temp)) last_temperature_ = observation.temp;
+  last_p1_ = observation.p1;
+  last_p2_ = observation.p2;
 
   // A faulty or suspect channel: neither decide nor learn; the score and the alarm hold.
   if (fed_ < blocked_until_) {
@@ -307,9 +309,14 @@ void ActuatorMonitor::import_state(const ActuatorState& state) {
 
 ActuatorStatus ActuatorMonitor::status() const {
   ActuatorStatus status;
+  status_into(status);
+  return status;
+}
+
+void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.name = config_.name;
   status.alarm = config_.alarm_name;
-  status.detector = std::string(detector_->name());
+  status.detector = detector_->name();
   status.state = alarm_.state();
   status.learning = last_decision_.learning;
   status.t = last_t_;
@@ -321,15 +328,23 @@ ActuatorStatus ActuatorMonitor::status() const {
   status.leak_coefficient = last_decision_.leak_coefficient;
   status.leak_coefficient_ci = last_decision_.leak_coefficient_ci;
   status.oil_temperature = last_temperature_;
+  status.p1 = last_p1_;
+  status.p2 = last_p2_;
+  status.raise_threshold = alarm_.settings().raise_threshold;
+  status.clear_threshold = alarm_.settings().clear_threshold;
   status.decisions = decisions_;
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;
   status.suspended_decisions = suspended_decisions_;
-  for (const auto& channel : channels_) {
-    status.channels.push_back({channel.role, channel.check.status(), channel.check.fault(),
-                               channel.check.spikes_rejected()});
+  status.channels.resize(channels_.size());
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    const auto& channel = channels_[i];
+    auto& out = status.channels[i];
+    out.channel = channel.role;
+    out.status = channel.check.status();
+    out.fault = channel.check.fault();
+    out.spikes_rejected = channel.check.spikes_rejected();
   }
-  return status;
 }
 
 }  // namespace leakmon::daemon

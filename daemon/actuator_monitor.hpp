@@ -57,6 +57,10 @@ struct ActuatorStatus {
       io::kNoValue;  // m^3/(s Pa), at 40 degC when the oil temperature is known
   double leak_coefficient_ci = io::kNoValue;  // its 95 % half-width
   double oil_temperature = io::kNoValue;      // degC, newest hop mean of the `temp` channel
+  double p1 = io::kNoValue;                   // Pa, chamber pressures: newest hop means
+  double p2 = io::kNoValue;
+  double raise_threshold = io::kNoValue;  // the alarm's effective thresholds on the score
+  double clear_threshold = io::kNoValue;
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
   std::vector<ChannelHealth> channels;
@@ -89,6 +93,9 @@ class ActuatorMonitor {
   bool same_pipeline(const ActuatorConfig& other, const ChannelLayout& other_layout) const;
 
   ActuatorStatus status() const;
+  // The same into `out`, reusing its strings and channel list: allocates nothing once `out`
+  // has held this actuator's status (the live page samples it every second).
+  void status_into(ActuatorStatus& out) const;
 
   // Persistence across restarts (state_store.hpp). Not for the real-time path: both allocate.
   const StateFingerprint& fingerprint() const { return fingerprint_; }
@@ -155,6 +162,7 @@ class ActuatorMonitor {
   double last_t_ = io::kNoValue;
   double last_load_pressure_ = io::kNoValue;
   double last_temperature_ = io::kNoValue;
+  double last_p1_ = io::kNoValue, last_p2_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
 };

@@ -298,9 +298,27 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     config.state.save_seconds = state->get_double("save_seconds", 60.0, 1.0, 86400.0);
   }
   if (auto metrics = root.find("metrics")) {
-    metrics->expect_keys({"address", "port"});
+    metrics->expect_keys({"address", "port", "ack_token", "trend_seconds", "trend_interval_s"});
     config.metrics.address = metrics->get_string("address", config.metrics.address);
     config.metrics.port = static_cast<int>(metrics->get_int("port", config.metrics.port, 0, 65535));
+    config.metrics.ack_token = metrics->get_string("ack_token", "");
+    if (auto token = metrics->find("ack_token"); token && config.metrics.ack_token.size() < 16) {
+      token->fail("an acknowledgement token needs at least 16 characters");
+    }
+    if (config.metrics.port != 0 && config.metrics.ack_token.empty() &&
+        !is_loopback_address(config.metrics.address)) {
+      metrics->at("address").fail(fmt::format(
+          "'{}' is reachable from other machines: set metrics.ack_token (>= 16 characters) so "
+          "that only holders of the token can acknowledge alarms",
+          config.metrics.address));
+    }
+    config.metrics.trend_interval_s = metrics->get_double("trend_interval_s", 1.0, 0.1, 3600.0);
+    config.metrics.trend_seconds =
+        metrics->get_double("trend_seconds", config.metrics.trend_seconds, 60.0, 7 * 86400.0);
+    if (config.metrics.trend_seconds / config.metrics.trend_interval_s > 1e6) {
+      metrics->at("trend_seconds")
+          .fail("more than 1000000 trend points per actuator: raise trend_interval_s");
+    }
   }
   if (auto worker = root.find("worker")) {
     worker->expect_keys({"priority", "poll_us"});
@@ -321,6 +339,10 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     }
   }
   return config;
+}
+
+bool is_loopback_address(const std::string& address) {
+  return address.rfind("127.", 0) == 0 || address == "::1" || address == "localhost";
 }
 
 DaemonConfig load_config(const std::string& path) {

@@ -78,7 +78,15 @@ std::string default_state_directory();
 struct MetricsConfig {
   std::string address = "127.0.0.1";
   int port = 9187;  // 0 disables the metrics and control endpoint
+  // Required by POST /ack when set; check-config demands one for a non-loopback address.
+  std::string ack_token;
+  // The live page's in-memory trend (daemon/trend_history.hpp): how far back, how finely.
+  double trend_seconds = 4 * 3600.0;
+  double trend_interval_s = 1.0;
 };
+
+// 127.0.0.0/8, ::1 or localhost: reachable from this machine only.
+bool is_loopback_address(const std::string& address);
 
 struct DaemonConfig {
   std::string source;  // file the configuration came from, for messages

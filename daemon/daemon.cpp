@@ -48,7 +48,8 @@ std::string acquisition_signature(const DaemonConfig& config) {
   text += fmt::format("recording {} {} {} {}\n", config.recording.directory,
                       config.recording.rotate_seconds, config.recording.keep_files,
                       config.recording.flush_seconds);
-  text += fmt::format("metrics {}:{}\n", config.metrics.address, config.metrics.port);
+  text += fmt::format("metrics {}:{} trend {} {}\n", config.metrics.address, config.metrics.port,
+                      config.metrics.trend_seconds, config.metrics.trend_interval_s);
   text += fmt::format("worker {} {}\n", config.worker_priority, config.worker_poll_ns);
   text += fmt::format("realtime {}\n", config.cpu_wakeup_latency_us);
   text += fmt::format("state {}\n", config.state.directory);
@@ -66,6 +67,7 @@ std::vector<std::unique_ptr<io::EventSink>> Daemon::build_sinks(const DaemonConf
   sinks.push_back(std::make_unique<LogEventSink>());
   if (!config.event_log.empty()) sinks.push_back(std::make_unique<JsonlEventLog>(config.event_log));
   for (const auto& node : config.outputs) sinks.push_back(make_output(node));
+  if (operator_view_) sinks.push_back(operator_view_->event_sink());  // the page's last events
   return sinks;
 }
 
@@ -142,6 +144,11 @@ void Daemon::start() {
     groups_.push_back(std::move(group));
   }
   reported_overruns_.assign(groups_.size(), 0);
+  if (config_.metrics.port != 0) {
+    std::vector<std::string> group_names;
+    for (const auto& group : groups_) group_names.push_back(group->config.name);
+    operator_view_ = std::make_unique<OperatorView>(config_, group_names);
+  }
   sinks_ = build_sinks(config_);
   worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
   attach_readings(sinks_, true);
@@ -208,6 +215,9 @@ void Daemon::start() {
         [this](const HttpRequest& request) { return handle(request); });
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
+    operator_view_->start_sampling([this](ViewSnapshot& out) { fill_view_snapshot(out); });
+    spdlog::info("live page on http://{}:{}/ ({:.1f} MB of trend history)", config_.metrics.address,
+                 endpoint_->port(), static_cast<double>(operator_view_->history_bytes()) / 1e6);
   }
   if (!config_.event_log.empty()) spdlog::info("events: {}", config_.event_log);
   if (!config_.recording.directory.empty()) {
@@ -249,6 +259,7 @@ void Daemon::stop() {
   worker_->flush();
   endpoint_.reset();
   attach_readings(sinks_, false);
+  operator_view_.reset();
   std::uint64_t pushed = 0, drops = 0;
   for (const auto& group : groups_) {
     pushed += group->loop->counters().samples_pushed.load();
@@ -358,6 +369,7 @@ void Daemon::reload() {
       sinks_.swap(sinks);  // the old sinks go only after the worker stopped using them
     }
     config_ = std::move(next);
+    if (operator_view_) operator_view_->set_ack_token(config_.metrics.ack_token);
     ++reloads_;
     last_reload_ok_ = true;
     event.kind = io::EventKind::config_reloaded;
@@ -411,19 +423,19 @@ int Daemon::run(double duration_s) {
 }
 
 HttpResponse Daemon::handle(const HttpRequest& request) {
+  if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
   if (request.path == "/metrics" && request.method == "GET")
     return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
   if (request.path == "/status" && request.method == "GET")
     return {200, "text/plain; charset=utf-8", status_text()};
   if (request.path == "/ack") {
     if (request.method != "POST") return {405, "text/plain", "use POST /ack?actuator=NAME\n"};
-    std::string actuator;
-    if (request.query.rfind("actuator=", 0) == 0) actuator = request.query.substr(9);
+    const std::string actuator = query_value(request.query, "actuator");
     const std::size_t matched = worker_->acknowledge(actuator);
     if (matched == 0) return {404, "text/plain", fmt::format("no actuator '{}'\n", actuator)};
     return {200, "text/plain", fmt::format("acknowledged {} actuator(s)\n", matched)};
   }
-  return {404, "text/plain", "try /metrics, /status or POST /ack\n"};
+  return {404, "text/plain", "try /, /metrics, /status or POST /ack\n"};
 }
 
 }  // namespace leakmon::daemon

@@ -19,6 +19,7 @@
 #include "daemon/config.hpp"
 #include "daemon/cpu_latency_request.hpp"
 #include "daemon/http_endpoint.hpp"
+#include "daemon/operator_view.hpp"
 #include "daemon/service_notifier.hpp"
 #include "daemon/state_store.hpp"
 #include "daemon/worker.hpp"
@@ -77,6 +78,8 @@ class Daemon {
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   HttpResponse handle(const HttpRequest& request);
+  // The live page's sample of the status (daemon/operator_view.cpp).
+  void fill_view_snapshot(ViewSnapshot& out) const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -86,6 +89,7 @@ class Daemon {
   mutable std::mutex sinks_mutex_;  // a reload swaps sinks_ while /metrics reads them
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
+  std::unique_ptr<OperatorView> operator_view_;  // the live page; null without an endpoint
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;

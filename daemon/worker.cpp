@@ -209,6 +209,17 @@ std::vector<ActuatorStatus> Worker::status() const {
   return result;
 }
 
+void Worker::status_into(std::vector<ActuatorStatus>& out) const {
+  std::lock_guard lock(mutex_);
+  std::size_t count = 0;
+  for (const auto& group : groups_) count += group.monitors.size();
+  out.resize(count);
+  std::size_t i = 0;
+  for (const auto& group : groups_) {
+    for (const auto& monitor : group.monitors) monitor->status_into(out[i++]);
+  }
+}
+
 std::uint64_t Worker::samples_processed() const {
   std::lock_guard lock(mutex_);
   return samples_;

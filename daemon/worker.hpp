@@ -56,6 +56,9 @@ class Worker {
   void restore_states(const StateStore& store);
 
   std::vector<ActuatorStatus> status() const;
+  // The same into `out`, reusing its storage: allocates nothing while the actuators are the
+  // same as at the previous call (a reload that adds actuators allocates once).
+  void status_into(std::vector<ActuatorStatus>& out) const;
   std::uint64_t samples_processed() const;
   std::uint64_t events_published() const;
   // From a sample's acquisition (monotonic) to the end of its decision and events.

@@ -13,4 +13,5 @@ $SUDO apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=300 \
   python3 python3-numpy python3-pywt python3-matplotlib python3-pymodbus python3-serial python3-serial-asyncio python3-can \
   socat can-utils rt-tests stress-ng systemd \
   qemu-system-x86 busybox-static xz-utils cpio \
-  prometheus python3-yaml
+  prometheus python3-yaml \
+  chromium chromium-driver python3-selenium
