@@ -14,10 +14,20 @@
 namespace leakmon::daemon {
 namespace {
 
+// Always valid UTF-8 JSON text: quotes, backslashes and every control character (C0, DEL, C1:
+// ESC and CSI included) escaped, bytes that are not UTF-8 replaced by U+FFFD.
 void append_json_string(std::string& out, std::string_view text) {
   out += '"';
-  for (char c : text) {
-    switch (c) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    unsigned code = 0;
+    const std::size_t length = config::utf8_sequence(text, i, code);
+    if (length == 0) {
+      out += "\\ufffd";
+      ++i;
+      continue;
+    }
+    switch (code) {
       case '"':
         out += "\\\"";
         break;
@@ -34,12 +44,13 @@ void append_json_string(std::string& out, std::string_view text) {
         out += "\\t";
         break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        if (code < 0x20 || (code >= 0x7f && code < 0xa0)) {
+          out += fmt::format("\\u{:04x}", code);
         } else {
-          out += c;
+          out.append(text.substr(i, length));
         }
     }
+    i += length;
   }
   out += '"';
 }
@@ -96,6 +107,13 @@ std::string to_json_line(const io::Event& event) {
   json.number("leak_lpm_ci95", event.leak_lpm_ci95);
   json.number("load_pressure_mpa", event.load_pressure / 1e6);
   if (is_alarm(event.kind)) json.boolean("latched", event.latched);
+  json.string("version", event.version);
+  json.string("config", event.config);
+  if (event.pid != 0) json.number("pid", static_cast<double>(event.pid));
+  json.string("reason", event.reason);
+  json.number("uptime_s", event.uptime_s);
+  json.number("learning_since", event.learning_since);
+  json.number("protected_from", event.protected_from);
   json.string("message", event.message);
   if (std::isfinite(event.unix_time)) {
     const auto seconds = static_cast<std::time_t>(event.unix_time);
@@ -120,8 +138,20 @@ std::string to_log_line(const io::Event& event) {
     line += fmt::format(" leak={:.3f}l/min/MPa", event.leak_lpm_per_mpa);
   }
   if (std::isfinite(event.leak_lpm)) line += fmt::format(" ({:.3f}l/min at load)", event.leak_lpm);
+  if (!event.version.empty()) line += fmt::format(" version={}", event.version);
+  if (event.pid != 0) line += fmt::format(" pid={}", event.pid);
+  if (!event.config.empty()) line += fmt::format(" config={}", event.config);
+  if (!event.reason.empty()) line += fmt::format(" reason={}", event.reason);
+  if (std::isfinite(event.uptime_s)) line += fmt::format(" uptime={:.1f}s", event.uptime_s);
+  if (std::isfinite(event.learning_since)) {
+    line += fmt::format(" learning_since={:.3f}s", event.learning_since);
+  }
+  if (std::isfinite(event.protected_from)) {
+    line += fmt::format(" protected_from={:.3f}s", event.protected_from);
+  }
   if (!event.message.empty()) line += fmt::format(": {}", event.message);
-  return line;
+  // Event text can carry configuration and device content: no raw escape sequences in the log.
+  return config::printable(line, 4000);
 }
 
 JsonlEventLog::JsonlEventLog(const std::string& path) : path_(path) {
@@ -151,7 +181,8 @@ void LogEventSink::publish(const io::Event& event) {
   const auto level =
       (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
        event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected ||
-       event.kind == io::EventKind::state_discarded || event.kind == io::EventKind::state_save_failed)
+       event.kind == io::EventKind::state_discarded ||
+       event.kind == io::EventKind::state_save_failed)
           ? spdlog::level::warn
           : spdlog::level::info;
   spdlog::log(level, "{}", to_log_line(event));
