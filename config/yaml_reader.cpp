@@ -143,9 +143,9 @@ void reject_duplicate_keys(const std::string& text, const std::string& source_na
   std::istringstream in(text);
   YAML::Parser parser(in);
   DuplicateKeyFinder finder;
-  while (parser.HandleNextDocument(finder)) {
-    if (finder.duplicate()) break;
-  }
+  // The first document only, as YAML::Load reads it (and yaml-cpp 0.7 can report further
+  // "documents" without end on some malformed input).
+  parser.HandleNextDocument(finder);
   if (const auto& dup = finder.duplicate()) {
     throw ConfigError(
         fmt::format("{}: duplicate key '{}' (first given at line {}, column {}); "
@@ -193,6 +193,12 @@ void ConfigNode::fail(std::string_view message) const {
   throw ConfigError(fmt::format("{}: {}: {}", location(), printable(path_), safe));
 }
 
+std::string ConfigNode::key_text(const YAML::Node& key) const {
+  // A list or mapping as a key (`? [a, b]`) is valid YAML but names nothing here.
+  if (!key.IsScalar()) ConfigNode(key, source_, path_).fail("a key must be plain text");
+  return key.Scalar();
+}
+
 std::string ConfigNode::child_path(std::string_view key) const {
   return path_.empty() ? std::string(key) : fmt::format("{}.{}", path_, key);
 }
@@ -205,7 +211,7 @@ void ConfigNode::expect_keys(const std::vector<std::string>& allowed) const {
   if (is_null()) return;
   if (!node_.IsMap()) fail("expected a mapping of keys to values");
   for (const auto& kv : node_) {
-    const auto key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       ConfigNode key_node(kv.first, source_, child_path(key));
       key_node.fail(fmt::format("unknown key '{}' (allowed: {})", key, fmt::join(allowed, ", ")));
@@ -243,7 +249,7 @@ std::vector<std::pair<std::string, ConfigNode>> ConfigNode::entries() const {
   if (!node_.IsMap()) fail("expected a mapping of keys to values");
   std::vector<std::pair<std::string, ConfigNode>> out;
   for (const auto& kv : node_) {
-    auto key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     out.emplace_back(key, ConfigNode(kv.second, source_, child_path(key)));
   }
   return out;

@@ -88,6 +88,7 @@ class ConfigNode {
  private:
   ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source, std::string path);
   std::string child_path(std::string_view key) const;
+  std::string key_text(const YAML::Node& key) const;
 
   YAML::Node node_;
   std::shared_ptr<const std::string> source_;
