@@ -503,7 +503,11 @@ void check_port(const DaemonConfig& config) {
   if (bound == 0 && listening == 0) return;
   const int why = bound != 0 ? error : listen_error;
   std::string reason = std::strerror(why);
-  if (why == EADDRINUSE) reason = "in use by another program (another leakmon?)";
+  if (why == EADDRINUSE) {
+    reason =
+        "in use by another program (a running leakmon? to check a file for `systemctl reload` "
+        "while it runs, use check-config --no-probe)";
+  }
   if (why == EADDRNOTAVAIL) reason = "the address is not one of this machine's";
   if (why == EACCES) reason = "ports below 1024 need privilege";
   fail_at(config.metrics.where, config,

@@ -153,6 +153,8 @@ TEST(DaemonConfig, CheckConfigFindsMissingChannelsAndBadDriverTypes) {
 }
 
 TEST(DaemonConfig, ShippedExamplesAreValid) {
+  // Examples without `state:` use $STATE_DIRECTORY, which the pre-flight checks is writable.
+  ::setenv("STATE_DIRECTORY", test::scratch_dir("config_examples_state").c_str(), 1);
   for (const char* file : {"/config/demo.yaml", "/io/sim/sim.yaml",
                            "/bench/daemon/rss_8_channels.yaml", "/io/replay/replay.yaml"}) {
     // The file itself and its paths; the port may be taken by a concurrent test.
