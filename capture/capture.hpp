@@ -1,6 +1,11 @@
 // The capture CSV format of FORMATS.md: `#` comment lines (`# key: value` carries metadata),
 // one header line naming the columns (`t` required, others optional, any order), then one row
-// per sample. An empty field or `nan` is a gap. Errors name file, line and column.
+// per sample. An empty field or `nan` is a gap. Errors name file, line and column and quote at
+// most a short excerpt of the offending text. A UTF-8 byte-order mark (as spreadsheet tools
+// write) is skipped. A value that is not finite (`inf`) or beyond what the channel's transducer
+// can physically report (physical_range()) becomes a gap; the reader counts them and logs one
+// warning per file at its end. A capture without a single row is an error ("no samples") for
+// every reader, so that every command treats it alike.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +28,19 @@ class CaptureError : public std::runtime_error {
 
 inline constexpr double kGap = std::numeric_limits<double>::quiet_NaN();
 
+// The values a column can physically hold, generously (MODEL.md units: Pa, m, V, degC): beyond
+// them a value is a decoding or unit error, not a measurement. Pressures (p1, p2, ps, pt)
+// [-1, 100] MPa, positions (x, xref) +-10 m, the valve command u +-1000, temperatures
+// [-100, 500] degC; any other column +-1e12.
+struct PhysicalRange {
+  double lo, hi;
+};
+PhysicalRange physical_range(std::string_view column);
+
+// At most `max_chars` of `text` for an error message, "..." marking a cut; control characters
+// escaped.
+std::string excerpt(std::string_view text, std::size_t max_chars = 60);
+
 using Metadata = std::vector<std::pair<std::string, std::string>>;
 
 // Reads a capture row by row, so that captures larger than memory can be streamed.
@@ -41,8 +59,12 @@ class CaptureReader {
   std::size_t line_number() const { return line_number_; }
 
   // Reads the next row into `row` (size columns().size()). Returns false at end of file.
-  // Throws CaptureError naming file, line and column on malformed input or non-increasing t.
+  // Throws CaptureError naming file, line and column on malformed input or non-increasing t,
+  // and at the end of a file that had no row at all.
   bool next(std::span<double> row);
+
+  // Values that became gaps for being non-finite or beyond physical_range(), so far.
+  std::uint64_t rejected_values() const { return rejected_; }
 
  private:
   [[noreturn]] void fail(std::size_t column, std::string_view message) const;
@@ -56,6 +78,10 @@ class CaptureReader {
   std::string line_;
   double last_t_ = -std::numeric_limits<double>::infinity();
   bool have_t_ = false;
+  std::vector<PhysicalRange> ranges_;  // per column
+  std::uint64_t rejected_ = 0;
+  std::string first_rejected_;  // where and what, for the warning
+  bool warned_ = false;
 };
 
 // A whole capture in memory, column by column.

@@ -1,4 +1,5 @@
-// `leakmon check-config CONFIG.yaml`: validate without running.
+// `leakmon check-config CONFIG.yaml`: the pre-flight `leakmon run` itself performs before it
+// acquires anything (daemon::check_config), so that systemd's ExecStartPre and the start agree.
 #include <fmt/format.h>
 
 #include "cli/args.hpp"
@@ -8,14 +9,23 @@
 namespace leakmon::cli {
 
 int run_check_config(int argc, char** argv) {
-  ArgParser args("check-config", "validate a daemon configuration without running it");
+  ArgParser args("check-config",
+                 "validate a daemon configuration as `leakmon run` does before it starts: "
+                 "the file, addresses, paths, the metrics port and the devices");
   args.positional("config", "CONFIG.yaml");
+  args.flag("no-probe",
+            "check the file and its paths only: leave out this machine's devices (CAN "
+            "interfaces, serial ports) and whether the metrics port is free, e.g. for a "
+            "configuration written for another machine");
   if (!args.parse(argc, argv)) return 0;
   const std::string path = args.get("config");
+  daemon::Preflight preflight;
+  if (args.flag_set("no-probe")) preflight = daemon::Preflight{false, false};
   try {
-    const auto config = daemon::check_config(path);
-    fmt::print("{}: ok ({} driver(s), {} sampling group(s), {} actuator(s))\n", path,
-               config.drivers.size(), config.groups.size(), config.actuators.size());
+    const auto config = daemon::check_config(path, preflight);
+    fmt::print("{}: ok ({} driver(s), {} sampling group(s), {} actuator(s){})\n", path,
+               config.drivers.size(), config.groups.size(), config.actuators.size(),
+               preflight.devices ? "" : "; devices and port not probed");
     return 0;
   } catch (const std::exception& e) {
     fmt::print(stderr, "{}\n", e.what());

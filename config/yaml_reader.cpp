@@ -2,12 +2,16 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <yaml-cpp/eventhandler.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
+#include <system_error>
 
 namespace leakmon::config {
 namespace {
@@ -17,17 +21,154 @@ std::string mark_location(const std::string& source, const YAML::Mark& mark) {
   return fmt::format("{}:{}:{}", source, mark.line + 1, mark.column + 1);
 }
 
+// Walks the parser's events (the node API has already merged duplicate keys away) and remembers
+// the first key that repeats within one mapping. Each open collection is a frame; a mapping's
+// children alternate key, value, so the even-numbered ones are keys.
+class DuplicateKeyFinder final : public YAML::EventHandler {
+ public:
+  struct Duplicate {
+    std::string key;
+    YAML::Mark first;
+    YAML::Mark second;
+  };
+  const std::optional<Duplicate>& duplicate() const { return duplicate_; }
+
+  void OnDocumentStart(const YAML::Mark&) override { stack_.clear(); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { child(mark, nullptr); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { child(mark, nullptr); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string& value) override {
+    child(mark, &value);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    child(mark, nullptr);
+    stack_.push_back(Frame{false, 0, {}});
+  }
+  void OnSequenceEnd() override { pop(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    child(mark, nullptr);
+    stack_.push_back(Frame{true, 0, {}});
+  }
+  void OnMapEnd() override { pop(); }
+
+ private:
+  struct Frame {
+    bool is_map;
+    std::size_t children;
+    std::map<std::string, YAML::Mark> keys;
+  };
+  // A node begins; `scalar` is its text when it is a scalar (only scalar keys are compared).
+  void child(const YAML::Mark& mark, const std::string* scalar) {
+    if (stack_.empty()) return;
+    Frame& parent = stack_.back();
+    const bool is_key = parent.is_map && parent.children % 2 == 0;
+    ++parent.children;
+    if (!is_key || scalar == nullptr || duplicate_) return;
+    const auto [it, inserted] = parent.keys.emplace(*scalar, mark);
+    if (!inserted) duplicate_ = Duplicate{*scalar, it->second, mark};
+  }
+  void pop() {
+    if (!stack_.empty()) stack_.pop_back();
+  }
+
+  std::vector<Frame> stack_;
+  std::optional<Duplicate> duplicate_;
+};
+
+void append_escaped(std::string& out, unsigned code) {
+  out += code < 0x100 ? fmt::format("\\x{:02x}", code) : fmt::format("\\u{:04x}", code);
+}
+
 }  // namespace
 
-ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source,
-                       std::string path)
+std::size_t utf8_sequence(std::string_view text, std::size_t i, unsigned& code) {
+  const auto byte = static_cast<unsigned char>(text[i]);
+  if (byte < 0x80) {
+    code = byte;
+    return 1;
+  }
+  const std::size_t length = byte >= 0xf0 ? 4 : byte >= 0xe0 ? 3 : byte >= 0xc0 ? 2 : 0;
+  if (length == 0 || byte >= 0xf5 || i + length > text.size()) return 0;
+  code = length == 4 ? byte & 0x07u : length == 3 ? byte & 0x0fu : byte & 0x1fu;
+  for (std::size_t k = 1; k < length; ++k) {
+    const auto next = static_cast<unsigned char>(text[i + k]);
+    if ((next & 0xc0u) != 0x80u) return 0;
+    code = (code << 6) | (next & 0x3fu);
+  }
+  static constexpr unsigned kSmallest[] = {0, 0, 0x80, 0x800, 0x10000};
+  if (code < kSmallest[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;
+  return length;
+}
+
+std::string printable(std::string_view text, std::size_t max_bytes) {
+  std::string out;
+  out.reserve(std::min(text.size(), max_bytes) + 8);
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (out.size() >= max_bytes) {
+      out += "...";
+      break;
+    }
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte < 0x80) {
+      if (byte < 0x20 || byte == 0x7f) {
+        append_escaped(out, byte);
+      } else {
+        out += static_cast<char>(byte);
+      }
+      ++i;
+      continue;
+    }
+    unsigned code = 0;
+    const std::size_t length = utf8_sequence(text, i, code);
+    if (length == 0) {
+      out += "\xef\xbf\xbd";  // U+FFFD
+      ++i;
+      continue;
+    }
+    if (code < 0xa0) {
+      append_escaped(out, code);  // C1 controls (0x9b is a terminal's CSI)
+    } else {
+      out.append(text.substr(i, length));
+    }
+    i += length;
+  }
+  return out;
+}
+
+void reject_duplicate_keys(const std::string& text, const std::string& source_name) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DuplicateKeyFinder finder;
+  // The first document only, as YAML::Load reads it (and yaml-cpp 0.7 can report further
+  // "documents" without end on some malformed input).
+  parser.HandleNextDocument(finder);
+  if (const auto& dup = finder.duplicate()) {
+    throw ConfigError(
+        fmt::format("{}: duplicate key '{}' (first given at line {}, column {}); "
+                    "only one of them would take effect",
+                    mark_location(source_name, dup->second), printable(dup->key),
+                    dup->first.line + 1, dup->first.column + 1));
+  }
+}
+
+ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source, std::string path)
     : node_(std::move(node)), source_(std::move(source)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::load_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError(fmt::format(
+        "{}: is a directory, not a configuration file (name the YAML file in it)", path));
+  }
   std::ifstream in(path);
   if (!in) throw ConfigError(fmt::format("{}: cannot open file", path));
   std::stringstream text;
   text << in.rdbuf();
+  if (in.bad()) throw ConfigError(fmt::format("{}: cannot read file", path));
   return load_string(text.str(), path);
 }
 
@@ -35,18 +176,27 @@ ConfigNode ConfigNode::load_string(const std::string& text, const std::string& s
   auto source = std::make_shared<const std::string>(source_name);
   try {
     YAML::Node root = YAML::Load(text);
+    reject_duplicate_keys(text, source_name);
     if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     return ConfigNode(root, source, "");
   } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}: {}", mark_location(source_name, e.mark), e.msg));
+    throw ConfigError(fmt::format("{}: {}", mark_location(source_name, e.mark), printable(e.msg)));
   }
 }
 
 std::string ConfigNode::location() const { return mark_location(*source_, node_.Mark()); }
 
 void ConfigNode::fail(std::string_view message) const {
-  if (path_.empty()) throw ConfigError(fmt::format("{}: {}", location(), message));
-  throw ConfigError(fmt::format("{}: {}: {}", location(), path_, message));
+  // Messages quote configuration content: escaped here, once, for every caller.
+  const std::string safe = printable(message, 2000);
+  if (path_.empty()) throw ConfigError(fmt::format("{}: {}", location(), safe));
+  throw ConfigError(fmt::format("{}: {}: {}", location(), printable(path_), safe));
+}
+
+std::string ConfigNode::key_text(const YAML::Node& key) const {
+  // A list or mapping as a key (`? [a, b]`) is valid YAML but names nothing here.
+  if (!key.IsScalar()) ConfigNode(key, source_, path_).fail("a key must be plain text");
+  return key.Scalar();
 }
 
 std::string ConfigNode::child_path(std::string_view key) const {
@@ -61,7 +211,7 @@ void ConfigNode::expect_keys(const std::vector<std::string>& allowed) const {
   if (is_null()) return;
   if (!node_.IsMap()) fail("expected a mapping of keys to values");
   for (const auto& kv : node_) {
-    const auto key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       ConfigNode key_node(kv.first, source_, child_path(key));
       key_node.fail(fmt::format("unknown key '{}' (allowed: {})", key, fmt::join(allowed, ", ")));
@@ -99,7 +249,7 @@ std::vector<std::pair<std::string, ConfigNode>> ConfigNode::entries() const {
   if (!node_.IsMap()) fail("expected a mapping of keys to values");
   std::vector<std::pair<std::string, ConfigNode>> out;
   for (const auto& kv : node_) {
-    auto key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     out.emplace_back(key, ConfigNode(kv.second, source_, child_path(key)));
   }
   return out;

@@ -21,6 +21,20 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// `text` made safe for a terminal, a log and a JSON string: control characters (ESC included)
+// become `\xNN`, bytes that are not valid UTF-8 become U+FFFD, and anything longer than
+// `max_bytes` is cut with "...". Configuration content reaches messages only through this.
+std::string printable(std::string_view text, std::size_t max_bytes = 200);
+
+// The length of the valid UTF-8 sequence at text[i] (1 to 4) with its code point in `code`, or
+// 0 when the bytes there are not valid UTF-8 (stray continuation, overlong form, surrogate,
+// beyond U+10FFFF, cut short).
+std::size_t utf8_sequence(std::string_view text, std::size_t i, unsigned& code);
+
+// Throws ConfigError at the second occurrence of a key in any mapping of `text` (yaml-cpp's
+// node API keeps one of them silently), naming both places. Parse errors are left to the loader.
+void reject_duplicate_keys(const std::string& text, const std::string& source_name);
+
 // One node of a loaded document, with the file name and the dotted path that led to it.
 class ConfigNode {
  public:
@@ -45,9 +59,9 @@ class ConfigNode {
   void expect_keys(const std::vector<std::string>& allowed) const;
 
   bool has(std::string_view key) const;
-  ConfigNode at(std::string_view key) const;                      // required
-  std::optional<ConfigNode> find(std::string_view key) const;     // optional
-  std::vector<ConfigNode> items() const;                          // sequence elements
+  ConfigNode at(std::string_view key) const;                        // required
+  std::optional<ConfigNode> find(std::string_view key) const;       // optional
+  std::vector<ConfigNode> items() const;                            // sequence elements
   std::vector<std::pair<std::string, ConfigNode>> entries() const;  // mapping entries in order
 
   // Scalar conversions; a wrong type fails with the expected type in the message.
@@ -74,6 +88,7 @@ class ConfigNode {
  private:
   ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source, std::string path);
   std::string child_path(std::string_view key) const;
+  std::string key_text(const YAML::Node& key) const;
 
   YAML::Node node_;
   std::shared_ptr<const std::string> source_;

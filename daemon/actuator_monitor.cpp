@@ -1,7 +1,6 @@
 #include "daemon/actuator_monitor.hpp"
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <cmath>
@@ -35,13 +34,6 @@ std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
   return detect::make_detector(config.detector, signals, hop_seconds, options);
 }
 
-std::string yaml_text(const std::optional<config::ConfigNode>& node) {
-  if (!node) return {};
-  YAML::Emitter out;
-  out << node->yaml();
-  return out.c_str();
-}
-
 }  // namespace
 
 ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayout& layout,
@@ -54,7 +46,8 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       fingerprint_(state_fingerprint(config, period_ns)),
       activity_(config.features.window, kNaN),
       index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
-      sample_rate_hz_(1e9 / static_cast<double>(period_ns)) {
+      sample_rate_hz_(1e9 / static_cast<double>(period_ns)),
+      period_ns_(period_ns) {
   const double rate = sample_rate_hz_;
   channels_.reserve(3);
   for (auto [role, index, spec, slot] :
@@ -94,15 +87,35 @@ void ActuatorMonitor::set_transducers(const ActuatorConfig& config) {
 
 bool ActuatorMonitor::same_pipeline(const ActuatorConfig& other,
                                     const ChannelLayout& other_layout) const {
-  const auto& a = config_.features;
-  const auto& b = other.features;
   return layout_.p1 == other_layout.p1 && layout_.p2 == other_layout.p2 &&
          layout_.u == other_layout.u && layout_.x == other_layout.x &&
          layout_.xref == other_layout.xref && layout_.ps == other_layout.ps &&
-         layout_.temp == other_layout.temp && a.wavelet == b.wavelet && a.level == b.level &&
-         a.window == b.window && a.step == b.step && a.mode == b.mode &&
-         config_.detector == other.detector &&
-         yaml_text(config_.detector_options) == yaml_text(other.detector_options);
+         layout_.temp == other_layout.temp && fingerprint_ == state_fingerprint(other, period_ns_);
+}
+
+std::string ActuatorMonitor::fingerprint_change(const StateFingerprint& other) const {
+  std::string change;
+  for (const auto& [name, value] : other.parts) {
+    std::string before = "(none)";
+    for (const auto& [old_name, old_value] : fingerprint_.parts) {
+      if (old_name == name) before = old_value;
+    }
+    if (before == value) continue;
+    if (!change.empty()) change += "; ";
+    change += fmt::format("{}: {} -> {}", name, before.empty() ? "(none)" : before,
+                          value.empty() ? "(none)" : value);
+  }
+  return change.empty() ? "channel layout" : change;
+}
+
+double ActuatorMonitor::learning_seconds() const {
+  const double window_s = static_cast<double>(config_.features.window) / sample_rate_hz_;
+  return window_s + detector_->learning_seconds();
+}
+
+void ActuatorMonitor::note_relearning(std::uint64_t relearns, double protected_from) {
+  relearns_ = relearns;
+  protected_from_ = protected_from;
 }
 
 bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) {
@@ -120,6 +133,10 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
     suspect |= channel.check.suspect();
   }
   check_sensor_faults(sample.t, all_missing, publish);
+  if (std::isnan(protected_from_) && !std::isnan(sample.t)) {
+    protected_from_ = sample.t + learning_seconds();
+  }
+  if (!std::isnan(sample.t)) newest_t_ = sample.t;
   delay_[arrived_ % delay_.size()] = {sample.t, value_at(sample, layout_.u),
                                       value_at(sample, layout_.xref), value_at(sample, layout_.ps),
                                       value_at(sample, layout_.temp)};
@@ -336,6 +353,12 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;
   status.suspended_decisions = suspended_decisions_;
+  status.relearns = relearns_;
+  if (!status.learning) {
+    status.learning_remaining_s = 0.0;
+  } else if (!std::isnan(protected_from_) && !std::isnan(newest_t_)) {
+    status.learning_remaining_s = std::max(0.0, protected_from_ - newest_t_);
+  }
   status.channels.resize(channels_.size());
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     const auto& channel = channels_[i];

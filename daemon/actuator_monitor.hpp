@@ -66,6 +66,10 @@ struct ActuatorStatus {
   std::vector<ChannelHealth> channels;
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
+  // Source time until the detector decides (0 once it does; NaN before the first sample), and
+  // how often a reload made it learn again.
+  double learning_remaining_s = io::kNoValue;
+  std::uint64_t relearns = 0;
 };
 
 using EventPublisher = std::function<void(const io::Event&)>;
@@ -89,8 +93,21 @@ class ActuatorMonitor {
   void set_alarm_settings(const AlarmSettings& settings);
   // Adopt new transducer settings (reload): the plausibility checks keep their state.
   void set_transducers(const ActuatorConfig& config);
-  // True when `other` can take over this monitor's learned state (same signals and features).
+  // True when `other` can take over this monitor's learned state: the same state fingerprint
+  // (state_store.hpp: channels, features, detector kind and options, sample period) and layout.
   bool same_pipeline(const ActuatorConfig& other, const ChannelLayout& other_layout) const;
+  // What differs between this monitor's fingerprint and `other`'s, as "part: old -> new; ...".
+  std::string fingerprint_change(const StateFingerprint& other) const;
+
+  // Source time of the newest sample (NaN before the first).
+  double newest_t() const { return newest_t_; }
+  // Source time [s] from this monitor's first sample to the detector's first decision: the
+  // features' first window plus the detector's own learning.
+  double learning_seconds() const;
+  // This monitor replaces `relearns - 1` earlier ones whose learning a reload invalidated; it
+  // decides from source time `protected_from`.
+  void note_relearning(std::uint64_t relearns, double protected_from);
+  std::uint64_t relearns() const { return relearns_; }
 
   ActuatorStatus status() const;
   // The same into `out`, reusing its strings and channel list: allocates nothing once `out`
@@ -165,6 +182,10 @@ class ActuatorMonitor {
   double last_p1_ = io::kNoValue, last_p2_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
+  std::int64_t period_ns_;
+  double newest_t_ = io::kNoValue;
+  double protected_from_ = io::kNoValue;  // source time of the first decision (expected)
+  std::uint64_t relearns_ = 0;
 };
 
 }  // namespace leakmon::daemon

@@ -1,10 +1,18 @@
 #include "daemon/config.hpp"
 
+#include <arpa/inet.h>
 #include <fmt/format.h>
+#include <net/if.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
@@ -21,6 +29,12 @@ std::string checked_name(const config::ConfigNode& node, std::set<std::string>& 
                          std::string_view what) {
   const auto name_node = node.at("name");
   const std::string name = name_node.as_string();
+  if (config::printable(name, name.size() + 1) != name) {
+    name_node.fail(
+        fmt::format("{} name '{}' must be printable text (no control characters, "
+                    "valid UTF-8)",
+                    what, name));
+  }
   if (name.empty() || name.find_first_of(". \t/") != std::string::npos) {
     name_node.fail(
         fmt::format("{} name '{}' must be non-empty, without '.', '/' or spaces", what, name));
@@ -282,10 +296,12 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
   if (auto events = root.find("events")) {
     events->expect_keys({"log"});
     config.event_log = resolve_path(*events, events->get_string("log", ""));
+    config.event_log_where = events->find("log");
   }
   if (auto recording = root.find("recording")) {
     recording->expect_keys({"directory", "rotate_seconds", "keep_files", "flush_seconds"});
     config.recording.directory = resolve_path(*recording, recording->get_string("directory"));
+    config.recording.where = recording->at("directory");
     config.recording.rotate_seconds = recording->get_double("rotate_seconds", 3600.0, 1.0, 1e7);
     config.recording.keep_files =
         static_cast<std::size_t>(recording->get_int("keep_files", 24, 0, 1000000));
@@ -296,10 +312,20 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
     config.state.directory =
         resolve_path(*state, state->get_string("directory", config.state.directory));
     config.state.save_seconds = state->get_double("save_seconds", 60.0, 1.0, 86400.0);
+    config.state.where = state->find("directory");
   }
   if (auto metrics = root.find("metrics")) {
     metrics->expect_keys({"address", "port", "ack_token", "trend_seconds", "trend_interval_s"});
     config.metrics.address = metrics->get_string("address", config.metrics.address);
+    if (auto address = metrics->find("address")) {
+      in_addr parsed{};
+      if (::inet_pton(AF_INET, config.metrics.address.c_str(), &parsed) != 1) {
+        address->fail(fmt::format(
+            "'{}' is not an IPv4 address (write it as digits, e.g. 127.0.0.1 or 0.0.0.0; host "
+            "names such as localhost are not resolved)",
+            config.metrics.address));
+      }
+    }
     config.metrics.port = static_cast<int>(metrics->get_int("port", config.metrics.port, 0, 65535));
     config.metrics.ack_token = metrics->get_string("ack_token", "");
     if (auto token = metrics->find("ack_token"); token && config.metrics.ack_token.size() < 16) {
@@ -319,6 +345,8 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
       metrics->at("trend_seconds")
           .fail("more than 1000000 trend points per actuator: raise trend_interval_s");
     }
+    config.metrics.where = metrics->find("port");
+    if (!config.metrics.where) config.metrics.where = metrics;
   }
   if (auto worker = root.find("worker")) {
     worker->expect_keys({"priority", "poll_us"});
@@ -395,8 +423,159 @@ void check_channels(const DaemonConfig& config,
   }
 }
 
-DaemonConfig check_config(const std::string& path) {
+namespace {
+
+[[noreturn]] void fail_at(const std::optional<config::ConfigNode>& where,
+                          const DaemonConfig& config, const std::string& message) {
+  if (where) where->fail(message);
+  throw config::ConfigError(fmt::format("{}: {}", config.source, config::printable(message)));
+}
+
+// The deepest ancestor of `path` that exists (the path itself when it exists).
+std::filesystem::path existing_ancestor(std::filesystem::path path) {
+  std::error_code ec;
+  while (!path.empty() && !std::filesystem::exists(path, ec)) {
+    const auto parent = path.parent_path();
+    if (parent == path) break;
+    path = parent;
+  }
+  return path.empty() ? std::filesystem::path(".") : path;
+}
+
+// A directory the daemon writes into (creating it and its parents when missing): what exists
+// of it must be a directory it may write to.
+void check_directory(const std::string& directory, const std::optional<config::ConfigNode>& where,
+                     const DaemonConfig& config, std::string_view what) {
+  std::error_code ec;
+  const std::filesystem::path path(directory);
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_directory(path, ec)) {
+    fail_at(where, config, fmt::format("{} '{}' exists and is not a directory", what, directory));
+  }
+  const auto ancestor = existing_ancestor(path);
+  if (!std::filesystem::is_directory(ancestor, ec)) {
+    fail_at(where, config,
+            fmt::format("{} '{}' cannot be created: '{}' is not a directory", what, directory,
+                        ancestor.string()));
+  }
+  if (::access(ancestor.c_str(), W_OK | X_OK) != 0) {
+    fail_at(where, config,
+            fmt::format("{} '{}': '{}' is not writable by this user ({})", what, directory,
+                        ancestor.string(), std::strerror(errno)));
+  }
+}
+
+// A file the daemon appends to (its directory is created when missing).
+void check_writable_file(const std::string& file, const std::optional<config::ConfigNode>& where,
+                         const DaemonConfig& config, std::string_view what) {
+  std::error_code ec;
+  const std::filesystem::path path(file);
+  if (std::filesystem::is_directory(path, ec)) {
+    fail_at(where, config, fmt::format("{} '{}' is a directory; name a file in it", what, file));
+  }
+  if (std::filesystem::exists(path, ec)) {
+    if (::access(path.c_str(), W_OK) != 0) {
+      fail_at(where, config,
+              fmt::format("{} '{}' is not writable ({})", what, file, std::strerror(errno)));
+    }
+    return;
+  }
+  check_directory(path.parent_path().empty() ? "." : path.parent_path().string(), where, config,
+                  fmt::format("the directory of {}", what));
+}
+
+}  // namespace
+
+void check_paths(const DaemonConfig& config) {
+  if (!config.event_log.empty()) {
+    check_writable_file(config.event_log, config.event_log_where, config, "event log");
+  }
+  if (!config.recording.directory.empty()) {
+    check_directory(config.recording.directory, config.recording.where, config,
+                    "recording directory");
+  }
+  if (!config.state.directory.empty()) {
+    check_directory(config.state.directory, config.state.where, config, "state directory");
+  }
+  for (const auto& node : config.outputs) {
+    if (node.get_string("type") != "jsonl" || !node.has("path")) continue;
+    const auto path = node.at("path");
+    check_writable_file(path.as_string(), path, config, "output file");
+  }
+}
+
+void check_port(const DaemonConfig& config) {
+  if (config.metrics.port == 0) return;
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(config.metrics.port));
+  if (::inet_pton(AF_INET, config.metrics.address.c_str(), &addr.sin_addr) != 1) {
+    fail_at(config.metrics.where, config,
+            fmt::format("'{}' is not an IPv4 address", config.metrics.address));
+  }
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return;  // no sockets at all: the endpoint will say so itself
+  // As the endpoint binds: SO_REUSEADDR, so that a restart's TIME_WAIT is no conflict.
+  const int one = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
+  const int bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr));
+  const int error = errno;
+  const int listening = bound == 0 ? ::listen(fd, 1) : -1;
+  const int listen_error = errno;
+  ::close(fd);
+  if (bound == 0 && listening == 0) return;
+  const int why = bound != 0 ? error : listen_error;
+  std::string reason = std::strerror(why);
+  if (why == EADDRINUSE) {
+    reason =
+        "in use by another program (a running leakmon? to check a file for `systemctl reload` "
+        "while it runs, use check-config --no-probe)";
+  }
+  if (why == EADDRNOTAVAIL) reason = "the address is not one of this machine's";
+  if (why == EACCES) reason = "ports below 1024 need privilege";
+  fail_at(config.metrics.where, config,
+          fmt::format("cannot listen on {}:{}: {}", config.metrics.address, config.metrics.port,
+                      reason));
+}
+
+void check_devices(const DaemonConfig& config) {
+  for (const auto& driver : config.drivers) {
+    if (!driver.node) continue;
+    const auto& node = *driver.node;
+    if (driver.type == "can" && node.has("interface")) {
+      const auto interface = node.at("interface");
+      const std::string name = interface.as_string();
+      if (::if_nametoindex(name.c_str()) == 0) {
+        interface.fail(fmt::format(
+            "no network interface '{}' on this machine (ip link show; for a virtual bus: ip "
+            "link add dev {} type vcan)",
+            name, name));
+      }
+    }
+    if (driver.type == "modbus" && node.has("device")) {
+      const auto device = node.at("device");
+      const std::string path = device.as_string();
+      struct stat info {};
+      if (::stat(path.c_str(), &info) != 0) {
+        device.fail(fmt::format("serial port '{}': {}", path, std::strerror(errno)));
+      }
+      if (!S_ISCHR(info.st_mode)) {
+        device.fail(fmt::format("serial port '{}' is not a character device", path));
+      }
+      if (::access(path.c_str(), R_OK | W_OK) != 0) {
+        device.fail(
+            fmt::format("serial port '{}' is not readable and writable by this user "
+                        "({}; the dialout group?)",
+                        path, std::strerror(errno)));
+      }
+    }
+  }
+}
+
+DaemonConfig check_config(const std::string& path, const Preflight& preflight) {
   DaemonConfig config = load_config(path);
+  check_paths(config);
+  if (preflight.port) check_port(config);
+  if (preflight.devices) check_devices(config);
   std::vector<std::vector<std::string>> driver_channels;
   for (const auto& driver : config.drivers) {
     auto built = make_driver(*driver.node);

@@ -60,24 +60,27 @@ struct ActuatorConfig {
 };
 
 struct RecordingConfig {
-  std::string directory;           // empty: no recording
-  double rotate_seconds = 3600.0;  // start a new file after this much source time
-  std::size_t keep_files = 24;     // oldest files beyond this are deleted; 0 keeps all
+  std::string directory;                    // empty: no recording
+  std::optional<config::ConfigNode> where;  // `recording.directory`, for error locations
+  double rotate_seconds = 3600.0;           // start a new file after this much source time
+  std::size_t keep_files = 24;              // oldest files beyond this are deleted; 0 keeps all
   double flush_seconds = 1.0;
 };
 
 // Where what was learned is kept across restarts (state_store.hpp).
 struct StateConfig {
-  std::string directory;       // empty: nothing is kept (every start learns afresh)
-  double save_seconds = 60.0;  // save at least this often, and at shutdown
+  std::string directory;                    // empty: nothing is kept (every start learns afresh)
+  double save_seconds = 60.0;               // save at least this often, and at shutdown
+  std::optional<config::ConfigNode> where;  // `state.directory` when given
 };
 
 // $STATE_DIRECTORY (set by systemd for StateDirectory=leakmon), else /var/lib/leakmon.
 std::string default_state_directory();
 
 struct MetricsConfig {
-  std::string address = "127.0.0.1";
-  int port = 9187;  // 0 disables the metrics and control endpoint
+  std::string address = "127.0.0.1";        // an IPv4 address (names are not resolved)
+  int port = 9187;                          // 0 disables the metrics and control endpoint
+  std::optional<config::ConfigNode> where;  // `metrics.port` (else `metrics`) when given
   // Required by POST /ack when set; check-config demands one for a non-loopback address.
   std::string ack_token;
   // The live page's in-memory trend (daemon/trend_history.hpp): how far back, how finely.
@@ -94,8 +97,9 @@ struct DaemonConfig {
   std::vector<GroupConfig> groups;
   std::vector<ActuatorConfig> actuators;
   std::string event_log;  // JSON-lines file; empty: none
+  std::optional<config::ConfigNode> event_log_where;
   RecordingConfig recording;
-  StateConfig state{default_state_directory(), 60.0};
+  StateConfig state{default_state_directory(), 60.0, std::nullopt};
   MetricsConfig metrics;
   std::vector<config::ConfigNode> outputs;
   // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency
@@ -115,10 +119,26 @@ struct DaemonConfig {
 DaemonConfig parse_config(const config::ConfigNode& root);
 DaemonConfig load_config(const std::string& path);
 
-// Full validation as `leakmon check-config` does it: parse, then build (not start) every
-// driver, output and detector so their own option checks run, and check that every actuator
-// channel exists. Throws ConfigError.
-DaemonConfig check_config(const std::string& path);
+// What check_config() looks at on this machine besides the file itself.
+struct Preflight {
+  // Devices the drivers name: CAN interfaces exist, serial ports are character devices.
+  bool devices = true;
+  // The metrics address and port can be bound now (nothing else listens there). A running
+  // daemon's reload leaves this out: it holds the port itself.
+  bool port = true;
+};
+
+// Full validation, the one `leakmon check-config` and `leakmon run` (and SIGHUP) share, so that
+// systemd's ExecStartPre and the start never disagree: parse, build (not start) every driver,
+// output and detector so their own option checks run, check that every actuator channel
+// exists, that the event log, recording and state paths can be written, and what `preflight`
+// asks for. Throws ConfigError with `file:line:column: message`.
+DaemonConfig check_config(const std::string& path, const Preflight& preflight = {});
+
+// The machine-dependent part of check_config() on a parsed configuration. Throws ConfigError.
+void check_paths(const DaemonConfig& config);
+void check_port(const DaemonConfig& config);
+void check_devices(const DaemonConfig& config);
 
 // Checks actuator channel references and group sizes against the channels the built drivers
 // offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.

@@ -6,6 +6,8 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <unistd.h>
+
 #include <chrono>
 #include <ctime>
 
@@ -172,6 +174,15 @@ void Daemon::start() {
                  config_.state.directory, config_.state.save_seconds);
   }
 
+  {
+    io::Event event;
+    event.kind = io::EventKind::daemon_started;
+    event.version = LEAKMON_VERSION;
+    event.config = config_path_;
+    event.pid = static_cast<long long>(::getpid());
+    worker_->publish(event);
+  }
+
   std::vector<std::string> worker_warnings;
   std::atomic<bool> worker_ready{false};
   worker_thread_ = std::thread([this, &worker_warnings, &worker_ready] {
@@ -256,6 +267,20 @@ void Daemon::stop() {
   if (worker_thread_.joinable()) worker_thread_.join();
   worker_->drain(monotonic_now_ns());  // whatever the loops pushed last
   save_state();
+  {
+    // The last event: everything the loops, the worker and the state saving had to say is
+    // published before it, and the sinks are flushed after it.
+    io::Event event;
+    event.kind = io::EventKind::daemon_stopped;
+    event.version = LEAKMON_VERSION;
+    event.config = config_path_;
+    event.pid = static_cast<long long>(::getpid());
+    event.reason = stop_reason_;
+    if (started_ns_ > 0) {
+      event.uptime_s = static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9;
+    }
+    worker_->publish(event);
+  }
   worker_->flush();
   endpoint_.reset();
   attach_readings(sinks_, false);
@@ -352,7 +377,9 @@ void Daemon::reload() {
   spdlog::info("SIGHUP: reloading {}", config_path_);
   io::Event event;
   try {
-    DaemonConfig next = check_config(config_path_);
+    // Drivers and the metrics endpoint cannot change on reload (acquisition_signature), and
+    // the running daemon holds their devices and port itself: those are not probed again.
+    DaemonConfig next = check_config(config_path_, Preflight{false, false});
     if (acquisition_signature(next) != acquisition_signature(config_)) {
       throw config::ConfigError(fmt::format(
           "{}: drivers, sampling groups, recording, metrics, worker, realtime or state directory "
@@ -377,9 +404,9 @@ void Daemon::reload() {
   } catch (const std::exception& e) {
     ++reload_failures_;
     last_reload_ok_ = false;
-    spdlog::error("reload rejected, the running configuration stays: {}", e.what());
     event.kind = io::EventKind::config_rejected;
-    event.message = e.what();
+    event.message = config::printable(e.what(), 2000);
+    spdlog::error("reload rejected, the running configuration stays: {}", event.message);
   }
   last_reload_unix_ = static_cast<std::int64_t>(std::time(nullptr));
   worker_->publish(event);
@@ -404,16 +431,19 @@ int Daemon::run(double duration_s) {
     const int signal = sigtimedwait(&signals, nullptr, &timeout);
     if (signal == SIGTERM || signal == SIGINT) {
       spdlog::info("{}: stopping", signal == SIGTERM ? "SIGTERM" : "SIGINT");
+      stop_reason_ = signal == SIGTERM ? "signal SIGTERM" : "signal SIGINT";
       break;
     }
     if (signal == SIGHUP) reload();
     housekeeping(monotonic_now_ns());
     if (all_sources_ended()) {
       spdlog::info("every source has ended: stopping");
+      stop_reason_ = "end_of_sources";
       break;
     }
     if (deadline_ns > 0 && monotonic_now_ns() >= deadline_ns) {
       spdlog::info("--duration {} s reached: stopping", duration_s);
+      stop_reason_ = "duration";
       break;
     }
   }

@@ -107,6 +107,9 @@ class Daemon {
   std::int64_t last_watchdog_ns_ = 0;
   std::uint64_t last_processed_ = 0;
   std::int64_t started_ns_ = 0;
+  // Why the daemon stops, for the daemon_stopped event: set where the main loop ends; an
+  // exception that unwinds through run() leaves "error".
+  std::string stop_reason_ = "error";
 
   // Read by the metrics thread.
   std::atomic<std::uint64_t> reloads_{0};

@@ -1,5 +1,7 @@
 #include "daemon/event_log.hpp"
 
+#include "config/yaml_reader.hpp"
+
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -28,8 +30,20 @@ std::string to_log_line(const io::Event& event) {
     line += fmt::format(" leak={:.3f}l/min/MPa", event.leak_lpm_per_mpa);
   }
   if (std::isfinite(event.leak_lpm)) line += fmt::format(" ({:.3f}l/min at load)", event.leak_lpm);
+  if (!event.version.empty()) line += fmt::format(" version={}", event.version);
+  if (event.pid != 0) line += fmt::format(" pid={}", event.pid);
+  if (!event.config.empty()) line += fmt::format(" config={}", event.config);
+  if (!event.reason.empty()) line += fmt::format(" reason={}", event.reason);
+  if (std::isfinite(event.uptime_s)) line += fmt::format(" uptime={:.1f}s", event.uptime_s);
+  if (std::isfinite(event.learning_since)) {
+    line += fmt::format(" learning_since={:.3f}s", event.learning_since);
+  }
+  if (std::isfinite(event.protected_from)) {
+    line += fmt::format(" protected_from={:.3f}s", event.protected_from);
+  }
   if (!event.message.empty()) line += fmt::format(": {}", event.message);
-  return line;
+  // Event text can carry configuration and device content: no raw escape sequences in the log.
+  return config::printable(line, 4000);
 }
 
 JsonlEventLog::JsonlEventLog(const std::string& path) : path_(path) {

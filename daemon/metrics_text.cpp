@@ -131,6 +131,20 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   for (const auto& a : actuators) {
     out.sample("leakmon_detector_learning", label("actuator", a.name), flag(a.learning));
   }
+  out.family("leakmon_learning_remaining_seconds",
+             "source time until the detector decides (0: it decides; after a reload that "
+             "invalidated what it learned, until it has learned again)",
+             "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_learning_remaining_seconds", label("actuator", a.name),
+               a.learning_remaining_s);
+  }
+  out.family("leakmon_relearn_total",
+             "reloads that changed an option the learned state depends on (learning started over)",
+             "counter");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_relearn_total", label("actuator", a.name), a.relearns);
+  }
   out.family("leakmon_alarm_active", "1 while the alarm is annunciated", "gauge");
   for (const auto& a : actuators) {
     out.sample("leakmon_alarm_active",

@@ -56,19 +56,45 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
     const ChannelLayout layout = layout_of(actuator, group.input.channels);
     if (layout.p1 < 0) continue;  // another group's actuator
     std::unique_ptr<ActuatorMonitor> kept;
+    const ActuatorMonitor* replaced = nullptr;  // same actuator, learned state no longer valid
     if (previous != nullptr) {
       for (auto& old : *previous) {
-        if (old && old->name() == actuator.name && old->same_pipeline(actuator, layout)) {
+        if (!old || old->name() != actuator.name) continue;
+        if (old->same_pipeline(actuator, layout)) {
+          // Alarm thresholds and delays, transducer checks, outputs: the learning stays.
           kept = std::move(old);
           kept->set_alarm_settings(actuator.alarm);
           kept->set_transducers(actuator);
-          break;
+        } else {
+          replaced = old.get();
         }
+        break;
       }
     }
-    monitors.push_back(
-        kept ? std::move(kept)
-             : std::make_unique<ActuatorMonitor>(actuator, layout, group.input.period_ns));
+    if (kept) {
+      monitors.push_back(std::move(kept));
+      continue;
+    }
+    auto monitor = std::make_unique<ActuatorMonitor>(actuator, layout, group.input.period_ns);
+    if (replaced != nullptr) {
+      // What was learned depends on an option that changed: the new monitor learns again, and
+      // until it is done a leak is not detected (and would become its baseline). Announced, so
+      // that nobody believes the rig protected meanwhile.
+      io::Event event;
+      event.kind = io::EventKind::relearning;
+      event.actuator = actuator.name;
+      event.t = replaced->newest_t();
+      event.learning_since = replaced->newest_t();
+      event.protected_from = event.learning_since + monitor->learning_seconds();
+      event.reason = replaced->fingerprint_change(monitor->fingerprint());
+      event.message = fmt::format(
+          "the learned state does not fit the reloaded options; learning again for {:.0f} s, "
+          "no leak detection until then",
+          monitor->learning_seconds());
+      monitor->note_relearning(replaced->relearns() + 1, event.protected_from);
+      publish_locked(event);
+    }
+    monitors.push_back(std::move(monitor));
   }
   group.monitors = std::move(monitors);
 }

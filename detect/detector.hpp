@@ -75,6 +75,9 @@ class Detector {
   // source clock that may have started over. Forgets what is tied to times or to the previous
   // hop (what was learned stays).
   virtual void resume_after_gap() {}
+  // Source time [s] from a fresh start (or reset()) to its first decision: what it ignores as
+  // start-up transient plus what it learns from. NaN when the detector cannot say.
+  virtual double learning_seconds() const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 }  // namespace leakmon::detect

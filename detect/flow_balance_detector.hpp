@@ -77,6 +77,9 @@ class FlowBalanceDetector final : public Detector {
   void reset() override;
   DetectorState export_state() const override;
   void import_state(const DetectorState& state) override;
+  double learning_seconds() const override {
+    return options_.learning.settle_seconds + options_.learning.learn_seconds;
+  }
   void resume_after_gap() override;
 
  private:

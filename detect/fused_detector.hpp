@@ -4,6 +4,7 @@
 // target rate. The leak size comes from the first member that can size a leak.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,12 @@ class FusedDetector final : public Detector {
   void import_state(const DetectorState& state) override;
   void resume_after_gap() override {
     for (auto& member : members_) member->resume_after_gap();
+  }
+  // The fused score needs every member: the longest learning decides.
+  double learning_seconds() const override {
+    double longest = 0.0;
+    for (const auto& member : members_) longest = std::max(longest, member->learning_seconds());
+    return longest;
   }
 
   // The latest decision of each member (same order as given), for diagnostics and evaluation.

@@ -33,6 +33,9 @@ class PaperBaselineDetector final : public Detector {
   void reset() override;
   DetectorState export_state() const override;
   void import_state(const DetectorState& state) override;
+  double learning_seconds() const override {
+    return options_.learning.settle_seconds + options_.learning.learn_seconds;
+  }
 
  private:
   PaperBaselineOptions options_;

@@ -30,6 +30,12 @@ enum class EventKind {
   state_restored,
   state_discarded,
   state_save_failed,
+  // Lifecycle: the daemon started acquiring / stopped (after its last event was written).
+  daemon_started,
+  daemon_stopped,
+  // A reload changed an option what the detector learned depends on: it learns again, and
+  // detects nothing until `protected_from`.
+  relearning,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -56,6 +62,12 @@ constexpr std::string_view to_string(EventKind kind) {
       return "state_discarded";
     case EventKind::state_save_failed:
       return "state_save_failed";
+    case EventKind::daemon_started:
+      return "daemon_started";
+    case EventKind::daemon_stopped:
+      return "daemon_stopped";
+    case EventKind::relearning:
+      return "relearning";
   }
   return "unknown";
 }
@@ -86,6 +98,18 @@ struct Event {
   std::string message;              // human-readable detail (driver error text, counts...)
   double unix_time = kNoValue;  // wall-clock time of publication [s since 1970], set by the worker
   bool latched = false;         // alarm events: the alarm waits for acknowledgement
+  // daemon_started / daemon_stopped: the program's version, its configuration file, its pid,
+  // and (stopped) why and after how long.
+  std::string version;
+  std::string config;
+  long long pid = 0;   // 0: not set
+  std::string reason;  // daemon_stopped: signal, duration, end_of_sources, error; relearning: the
+                       // changed options
+  double uptime_s = kNoValue;
+  // relearning: source times [s] of the group's newest sample when learning began again, and
+  // from when the detector decides again (learning done).
+  double learning_since = kNoValue;
+  double protected_from = kNoValue;
 };
 
 // One actuator's newest decision as an output may sample it (the snapshot /metrics reads).

@@ -1,5 +1,7 @@
 #include "io/event_json.hpp"
 
+#include "config/yaml_reader.hpp"
+
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
@@ -9,10 +11,20 @@
 namespace leakmon::io {
 namespace {
 
+// Always valid UTF-8 JSON text: quotes, backslashes and every control character (C0, DEL, C1:
+// ESC and CSI included) escaped, bytes that are not UTF-8 replaced by U+FFFD.
 void append_json_string(std::string& out, std::string_view text) {
   out += '"';
-  for (char c : text) {
-    switch (c) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    unsigned code = 0;
+    const std::size_t length = config::utf8_sequence(text, i, code);
+    if (length == 0) {
+      out += "\\ufffd";
+      ++i;
+      continue;
+    }
+    switch (code) {
       case '"':
         out += "\\\"";
         break;
@@ -29,12 +41,13 @@ void append_json_string(std::string& out, std::string_view text) {
         out += "\\t";
         break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        if (code < 0x20 || (code >= 0x7f && code < 0xa0)) {
+          out += fmt::format("\\u{:04x}", code);
         } else {
-          out += c;
+          out.append(text.substr(i, length));
         }
     }
+    i += length;
   }
   out += '"';
 }
@@ -87,6 +100,13 @@ std::string to_json_line(const Event& event) {
   json.number("leak_lpm_ci95", event.leak_lpm_ci95);
   json.number("load_pressure_mpa", event.load_pressure / 1e6);
   if (is_alarm(event.kind)) json.boolean("latched", event.latched);
+  json.string("version", event.version);
+  json.string("config", event.config);
+  if (event.pid != 0) json.number("pid", static_cast<double>(event.pid));
+  json.string("reason", event.reason);
+  json.number("uptime_s", event.uptime_s);
+  json.number("learning_since", event.learning_since);
+  json.number("protected_from", event.protected_from);
   json.string("message", event.message);
   if (std::isfinite(event.unix_time)) {
     const auto seconds = static_cast<std::time_t>(event.unix_time);

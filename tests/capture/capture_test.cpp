@@ -41,7 +41,9 @@ TEST(Capture, RoundTripIsExact) {
   for (int i = 0; i < 1000; ++i) {
     original.values[0].push_back(i * 0.002);
     original.values[1].push_back(8.65e6 + 1e5 * uniform(rng));
-    original.values[2].push_back(1e-3 * uniform(rng) * std::pow(10.0, uniform(rng) * 20));
+    // Positions from 1e-23 m to 1 mm: every exponent, within x's physical range (+-10 m).
+    original.values[2].push_back(1e-3 * uniform(rng) *
+                                 std::pow(10.0, -20 * std::abs(uniform(rng))));
     original.values[3].push_back(i % 97 == 5 ? kGap : uniform(rng));
   }
   const std::string path = dir + "/capture.csv";
@@ -112,7 +114,7 @@ TEST(Capture, MalformedLinesNameFileLineAndColumn) {
       {"# c\nt,p1\n0,1\n0.002,abc\n", "4:2: column 'p1': 'abc' is not a number"},
       {"t,p1\n0,1\n0.002,1,7\n", "3:3: too many fields"},
       {"t,p1,p2\n0,1,2\n0.002,1\n", "3:2: too few fields"},
-      {"t,p1\n0,1\n0.002,inf\n", "3:2: column 'p1': infinite value"},
+      {"t,p1\n0,1\n0.002,1\ninf,1\n", "4:1: column 't': 'inf' is not a finite time"},
       {"t,p1\n0,1\n,2\n", "3:1: column 't' is empty"},
       {"t,p1\n0,1.5e\n", "2:2: column 'p1': '1.5e' is not a number"},
   };
@@ -122,6 +124,61 @@ TEST(Capture, MalformedLinesNameFileLineAndColumn) {
     const std::string message = read_error(path);
     EXPECT_TRUE(message.starts_with(path + ":" + bad.expected)) << message;
   }
+}
+
+TEST(Capture, NonFiniteAndAbsurdValuesBecomeCountedGaps) {
+  const std::string dir = test::scratch_dir("capture_absurd");
+  // p1 1e308 and inf, p2 -5 MPa (below a pressure transducer's range), x 1e999 (beyond double),
+  // u -inf; the plausible values next to them stay.
+  const std::string path = write_file(dir, "absurd.csv",
+                                      "t,p1,p2,x,u\n"
+                                      "0,8e6,7e6,0.01,1\n"
+                                      "0.002,1e308,7e6,0.01,1\n"
+                                      "0.004,inf,-5e6,1e999,-inf\n"
+                                      "0.006,8e6,7e6,0.02,2\n");
+  CaptureReader reader(path);
+  std::vector<double> row(5);
+  std::size_t rows = 0;
+  std::size_t gaps = 0;
+  while (reader.next(row)) {
+    ++rows;
+    for (double v : row) gaps += std::isnan(v) ? 1 : 0;
+    for (double v : row) EXPECT_FALSE(std::isinf(v));
+  }
+  EXPECT_EQ(rows, 4u);
+  EXPECT_EQ(gaps, 5u);
+  EXPECT_EQ(reader.rejected_values(), 5u);
+  const Capture whole = read_capture(path);
+  EXPECT_EQ(whole.column("p1")[0], 8e6);
+  EXPECT_TRUE(std::isnan(whole.column("p1")[1]));
+  EXPECT_EQ(whole.column("x")[3], 0.02);
+}
+
+TEST(Capture, ByteOrderMarkIsSkipped) {
+  const std::string dir = test::scratch_dir("capture_bom");
+  const std::string path = write_file(dir, "bom.csv", "\xef\xbb\xbft,p1\n0,1\n0.002,2\n");
+  const Capture capture = read_capture(path);
+  EXPECT_EQ(capture.columns, (std::vector<std::string>{"t", "p1"}));
+  EXPECT_EQ(capture.rows(), 2u);
+}
+
+TEST(Capture, HeaderOnlyIsNoSamplesWithOrWithoutMetadata) {
+  const std::string dir = test::scratch_dir("capture_header_only");
+  for (const std::string body : {"t,p1\n", "# sample_rate_hz: 500\nt,p1\n# end\n"}) {
+    const std::string path = write_file(dir, "empty.csv", body);
+    EXPECT_EQ(read_error(path), path + ": no samples (a header but not a single row)");
+  }
+}
+
+TEST(Capture, ErrorsQuoteOnlyAnExcerpt) {
+  const std::string dir = test::scratch_dir("capture_excerpt");
+  const std::string path =
+      write_file(dir, "long.csv", "t,p1\n0," + std::string(1 << 20, 'x') + "\n");
+  const std::string message = read_error(path);
+  EXPECT_LT(message.size(), 200u) << message.substr(0, 300);
+  EXPECT_NE(message.find("xxx...' is not a number"), std::string::npos) << message.substr(0, 300);
+  const std::string escape = write_file(dir, "escape.csv", "t,p1\n0,\x1b[2J\n");
+  EXPECT_EQ(read_error(escape).find('\x1b'), std::string::npos);
 }
 
 TEST(Capture, TimeMustStrictlyIncrease) {

@@ -39,7 +39,8 @@ TEST(ConfigNode, WrongTypeSaysWhatWasExpected) {
             "x.yaml:1:7: port: expected an integer, got 'ninety'");
   EXPECT_EQ(error_of([&] { root.get_bool("enabled", false); }),
             "x.yaml:2:10: enabled: expected true or false, got 'maybe'");
-  EXPECT_NE(error_of([&] { root.get_double("list"); }).find("expected a number"), std::string::npos);
+  EXPECT_NE(error_of([&] { root.get_double("list"); }).find("expected a number"),
+            std::string::npos);
 }
 
 TEST(ConfigNode, MissingRequiredKeyAndDefaults) {
@@ -53,7 +54,9 @@ TEST(ConfigNode, MissingRequiredKeyAndDefaults) {
 
 TEST(ConfigNode, ChoiceListsTheValidValues) {
   auto root = ConfigNode::load_string("mode: sym\n", "m.yaml");
-  EXPECT_EQ(error_of([&] { root.get_choice("mode", {"symmetric", "zero"}, "symmetric"); }),
+  EXPECT_EQ(error_of([&] {
+              root.get_choice("mode", {"symmetric", "zero"}, "symmetric");
+            }),
             "m.yaml:1:7: mode: 'sym' is not one of: symmetric, zero");
 }
 
@@ -82,6 +85,29 @@ TEST(ConfigNode, NonFiniteNumbersRejected) {
   auto root = ConfigNode::load_string("x: .inf\ny: nan\n", "n.yaml");
   EXPECT_NE(error_of([&] { root.get_double("x"); }).find("finite"), std::string::npos);
   EXPECT_NE(error_of([&] { root.get_double("y"); }).find("finite"), std::string::npos);
+}
+
+TEST(ConfigNode, DuplicateKeysAreErrorsAtTheSecondOccurrence) {
+  EXPECT_EQ(error_of([] { ConfigNode::load_string("a: 1\nb: {x: 1, x: 2}\n", "f.yaml"); }),
+            "f.yaml:2:11: duplicate key 'x' (first given at line 2, column 5); only one of them "
+            "would take effect");
+  EXPECT_EQ(error_of([] { ConfigNode::load_string("a: 1\nb:\n  c: 1\na: 2\n", "f.yaml"); }),
+            "f.yaml:4:1: duplicate key 'a' (first given at line 1, column 1); only one of them "
+            "would take effect");
+  EXPECT_EQ(error_of([] { ConfigNode::load_string("- {x: 1}\n- {x: 2}\n", "f.yaml"); }),
+            "no error");
+}
+
+// Found by fuzz/config_reader_fuzz.cpp: a list as a key escaped as a yaml-cpp exception, and a
+// malformed stream made the parser report documents without end.
+TEST(ConfigNode, FuzzFindingsStayConfigErrors) {
+  const ConfigNode root = ConfigNode::load_string("? [a, b]\n: 1\n", "f.yaml");
+  EXPECT_EQ(error_of([&] { root.expect_keys({"a"}); }), "f.yaml:1:3: a key must be plain text");
+  EXPECT_EQ(error_of([&] { (void)root.entries(); }), "f.yaml:1:3: a key must be plain text");
+  EXPECT_NO_THROW(
+      ConfigNode::load_string(", seed: 8}]\n: metrt: 1}\nmetr\xe9"
+                              "cs: {port: 2}\n",
+                              "f.yaml"));
 }
 
 }  // namespace

@@ -4,6 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <fstream>
 
@@ -148,12 +153,151 @@ TEST(DaemonConfig, CheckConfigFindsMissingChannelsAndBadDriverTypes) {
 }
 
 TEST(DaemonConfig, ShippedExamplesAreValid) {
+  // Examples without `state:` use $STATE_DIRECTORY, which the pre-flight checks is writable.
+  ::setenv("STATE_DIRECTORY", test::scratch_dir("config_examples_state").c_str(), 1);
   for (const char* file : {"/config/demo.yaml", "/io/sim/sim.yaml",
-                           "/bench/daemon/rss_8_channels.yaml", "/io/mqtt/mqtt.yaml"}) {
-    EXPECT_NO_THROW(check_config(test::source_dir() + file)) << file;
+                           "/bench/daemon/rss_8_channels.yaml", "/io/replay/replay.yaml",
+                           "/io/mqtt/mqtt.yaml"}) {
+    // The file itself and its paths; the port may be taken by a concurrent test.
+    EXPECT_NO_THROW(check_config(test::source_dir() + file, Preflight{true, false})) << file;
   }
-  // The replay sample names a capture that only exists on a rig: parse it, do not build it.
-  EXPECT_NO_THROW(load_config(test::source_dir() + "/io/replay/replay.yaml"));
+}
+
+// What `run` checks before it acquires, check-config checks too (one function): each failure
+// names file:line:column.
+std::string preflight_error(const std::string& dir, const std::string& name,
+                            const std::string& yaml, Preflight preflight = {}) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << yaml;
+  try {
+    check_config(path, preflight);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+constexpr const char* kBase =
+    "drivers: [{name: rig, type: sim, scenario: healthy}]\n"
+    "actuators: [{name: a, channels: {p1: p1}}]\n"
+    "state: {directory: ''}\n";
+
+TEST(DaemonConfig, MetricsAddressMustBeAnIpv4Address) {
+  const std::string dir = test::scratch_dir("config_preflight_address");
+  for (const char* address : {"256.1.1.1", "localhost", "1.2.3", "::1"}) {
+    const std::string e = preflight_error(
+        dir, "a.yaml", std::string(kBase) + "metrics: {address: '" + address + "'}\n");
+    EXPECT_NE(e.find("a.yaml:4:20: metrics.address: '" + std::string(address) +
+                     "' is not an IPv4 address"),
+              std::string::npos)
+        << e;
+  }
+  EXPECT_EQ(
+      preflight_error(dir, "b.yaml", std::string(kBase) + "metrics: {address: 0.0.0.0, port: 0}\n"),
+      "no error");
+}
+
+TEST(DaemonConfig, MetricsPortInUseIsAnError) {
+  const std::string dir = test::scratch_dir("config_preflight_port");
+  // Hold a listening socket on a port the kernel chose.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
+  ASSERT_EQ(::listen(fd, 1), 0);
+  socklen_t length = sizeof(addr);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length);
+  const std::string yaml =
+      std::string(kBase) + "metrics: {port: " + std::to_string(ntohs(addr.sin_port)) + "}\n";
+  const std::string e = preflight_error(dir, "a.yaml", yaml);
+  EXPECT_NE(e.find("a.yaml:4:17: metrics.port: cannot listen on 127.0.0.1:"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("in use"), std::string::npos) << e;
+  EXPECT_EQ(preflight_error(dir, "a.yaml", yaml, Preflight{false, false}), "no error");
+  ::close(fd);
+  EXPECT_EQ(preflight_error(dir, "a.yaml", yaml), "no error") << "free again";
+}
+
+TEST(DaemonConfig, PathsMustBeWritableAndOfTheRightKind) {
+  const std::string dir = test::scratch_dir("config_preflight_paths");
+  std::ofstream(dir + "/plain-file") << "x";
+  const std::string is_dir =
+      preflight_error(dir, "a.yaml", std::string(kBase) + "events: {log: " + dir + "}\n");
+  EXPECT_NE(is_dir.find("a.yaml:4:15: events.log: event log '" + dir + "' is a directory"),
+            std::string::npos)
+      << is_dir;
+  const std::string under_file = preflight_error(
+      dir, "b.yaml", std::string(kBase) + "events: {log: plain-file/events.jsonl}\n");
+  EXPECT_NE(under_file.find("b.yaml:4:15: events.log:"), std::string::npos) << under_file;
+  EXPECT_NE(under_file.find("is not a directory"), std::string::npos) << under_file;
+  const std::string recording =
+      preflight_error(dir, "c.yaml", std::string(kBase) + "recording: {directory: plain-file}\n");
+  EXPECT_NE(recording.find("c.yaml:4:24: recording.directory: recording directory"),
+            std::string::npos)
+      << recording;
+  const std::string state = preflight_error(dir, "d.yaml",
+                                            "drivers: [{name: rig, type: sim, scenario: healthy}]\n"
+                                            "actuators: [{name: a, channels: {p1: p1}}]\n"
+                                            "state: {directory: plain-file/kept}\n");
+  EXPECT_NE(state.find("d.yaml:3:20: state.directory:"), std::string::npos) << state;
+  // Missing directories that can be created are fine: the daemon creates them.
+  EXPECT_EQ(preflight_error(dir, "e.yaml",
+                            std::string(kBase) + "events: {log: new/sub/events.jsonl}\n"
+                                                 "recording: {directory: new/captures}\n"),
+            "no error");
+}
+
+TEST(DaemonConfig, CanInterfaceMustExistUnlessNotProbed) {
+  const std::string dir = test::scratch_dir("config_preflight_device");
+  const std::string yaml =
+      "drivers:\n"
+      "  - {name: bus, type: can, interface: lmnone9,\n"
+      "     signals: [{channel: p1, id: 0x101, start_bit: 0, length: 16, factor: 500}]}\n"
+      "actuators: [{name: a, channels: {p1: p1}}]\n"
+      "state: {directory: ''}\n"
+      "metrics: {port: 0}\n";
+  const std::string e = preflight_error(dir, "a.yaml", yaml);
+  EXPECT_NE(e.find("a.yaml:2:39: drivers[0].interface: no network interface 'lmnone9'"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(preflight_error(dir, "a.yaml", yaml, Preflight{false, true}), "no error");
+}
+
+TEST(DaemonConfig, DirectoryGivenAsTheConfigurationIsNamedAsSuch) {
+  const std::string dir = test::scratch_dir("config_preflight_directory");
+  try {
+    check_config(dir);
+    ADD_FAILURE() << "a directory was accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              dir + ": is a directory, not a configuration file (name the YAML file in it)");
+  }
+}
+
+TEST(DaemonConfig, DuplicateKeysAnywhereAreErrors) {
+  EXPECT_EQ(error_of("drivers: [{name: rig, type: sim, scenario: healthy, seed: 7, seed: 8}]\n"
+                     "actuators: [{name: a, channels: {p1: p1}}]\n"),
+            "rig.yaml:1:62: duplicate key 'seed' (first given at line 1, column 53); only one "
+            "of them would take effect");
+  EXPECT_EQ(error_of(std::string(kDriver) + "actuators: [{name: a, channels: {p1: p1}}]\n"
+                                            "metrics:\n  port: 9100\n"
+                                            "metrics:\n  port: 9200\n"),
+            "rig.yaml:5:1: duplicate key 'metrics' (first given at line 3, column 1); only one "
+            "of them would take effect");
+  // The same key in different mappings is no duplicate.
+  EXPECT_EQ(error_of(std::string(kDriver) +
+                     "actuators: [{name: a, channels: {p1: p1}}, {name: b, channels: {p1: p2}}]\n"),
+            "no error");
+}
+
+TEST(DaemonConfig, NamesWithControlCharactersAreRejectedAndEscaped) {
+  const std::string e = error_of(
+      "drivers: [{name: \"r\\e[31mig\", type: sim, scenario: healthy}]\n"
+      "actuators: [{name: a, channels: {p1: p1}}]\n");
+  EXPECT_NE(e.find("must be printable text"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\x1b'), std::string::npos) << "raw ESC in the message";
+  EXPECT_NE(e.find("r\\x1b[31mig"), std::string::npos) << e;
 }
 
 }  // namespace

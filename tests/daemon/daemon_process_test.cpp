@@ -183,7 +183,8 @@ TEST(DaemonProcess, CheckConfigNamesFileLineAndColumn) {
   EXPECT_NE(check.log().find("bad.yaml:5:"), std::string::npos) << check.log();
   EXPECT_NE(check.log().find("on_delay_s"), std::string::npos) << check.log();
 
-  test::DaemonProcess good({"check-config", test::source_dir() + "/config/demo.yaml"},
+  // --no-probe: the demo's port 9187 may be taken by a demo running on this machine.
+  test::DaemonProcess good({"check-config", "--no-probe", test::source_dir() + "/config/demo.yaml"},
                            dir + "/good.log");
   EXPECT_EQ(good.wait(30s), 0) << good.log();
 }

@@ -89,7 +89,7 @@ TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
   write_capture(dir, 31, 24.0);
   const DaemonRun first = run_daemon(dir, port, "first");
   ASSERT_EQ(first.exit_code, 0) << first.log;
-  EXPECT_EQ(first.events.find("state_"), std::string::npos) << "nothing saved before";
+  EXPECT_EQ(first.events.find("\"event\": \"state_"), std::string::npos) << "nothing saved before";
   const fs::path file = dir + "/state/cyl.state";
   ASSERT_TRUE(fs::exists(file)) << first.log;
   const std::string shown = show(dir);
