@@ -81,8 +81,9 @@ int run_evaluate(int argc, char** argv) {
               "conditions.md and conditions.tsv",
               "stationary")
       .option("sensor-fault-runs", "N",
-              "extra runs with one sensor fault each (kinds in turn; every second one with a "
-              "1e-12 leak opening during the fault), scored per fault kind in conditions.md",
+              "extra runs with one sensor fault each (the six kinds in turn, each kind's runs "
+              "alternately with a 1e-12 leak opening during the fault), scored per fault kind in "
+              "conditions.md",
               "0")
       .option("after-restart", "S", "how long a healthy restart is watched", "300")
       .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",

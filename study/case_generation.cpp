@@ -168,9 +168,9 @@ std::vector<Condition> plan_conditions(const EvaluationOptions& options) {
     }
   }
   for (int i = 0; i < options.sensor_fault_runs; ++i) {
-    plan.push_back(
-        {SensorFaultCondition{i % 2 == 1 ? kSensorFaultLeak : 0.0, options.after_fault_seconds},
-         options.effects, "sensor-faults"});
+    plan.push_back({SensorFaultCondition{(i / 6) % 2 == 1 ? kSensorFaultLeak : 0.0,
+                                         options.after_fault_seconds, i % 6},
+                    options.effects, "sensor-faults"});
   }
   return plan;
 }
@@ -212,7 +212,7 @@ RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
   if (const auto* fault = std::get_if<SensorFaultCondition>(&condition.kind)) {
     // A fault 10-40 s into monitoring; in a leak run the leak opens while it lasts.
     const double start = run.monitor_from + uniform(operating_draws, 0.0, 30.0);
-    draw_sensor_fault(operating_draws, id % 6, start, start, run);
+    draw_sensor_fault(operating_draws, fault->kind, start, start, run);
     if (fault->coefficient > 0.0) {
       run.leak = fault->coefficient;
       run.onset = uniform(operating_draws, run.fault_start, run.fault_end);

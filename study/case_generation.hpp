@@ -36,6 +36,8 @@ struct LeakCondition {
 struct SensorFaultCondition {
   double coefficient = 0.0;
   double after_fault_seconds = 0.0;
+  // 0 frozen, 1 saturated high, 2 saturated low, 3 spikes, 4 dropout to zero, 5 dropout to gaps
+  int kind = 0;
 };
 
 struct Condition {
@@ -75,7 +77,8 @@ struct RunSpec {
 
 // The evaluation's conditions in run order: healthy_runs healthy runs, then runs_per_leak leak
 // runs per leak size, each with the options' effects, then sensor_fault_runs SensorFaultCondition
-// runs (every second one with a leak of kSensorFaultLeak opening during the fault).
+// runs: the kinds in turn, each kind's runs alternately without and with a leak of
+// kSensorFaultLeak opening during the fault.
 inline constexpr double kSensorFaultLeak = 1e-12;
 std::vector<Condition> plan_conditions(const EvaluationOptions& options);
 

@@ -200,10 +200,11 @@ TEST(EvaluationRun, SensorFaultRunsAreNamedPerKindAndTheLeakIsFoundAfterwards) {
   EvaluationOptions options = short_options(9);
   options.healthy_runs = 0;
   options.runs_per_leak = 0;
-  options.sensor_fault_runs = 6;
+  options.sensor_fault_runs = 12;
+  options.after_fault_seconds = 65.0;  // the minute after the fault, and a little
   options.out = test::scratch_dir("study_evaluation_sensor_faults");
   const auto runs = draw_runs(options);
-  ASSERT_EQ(runs.size(), 6u);
+  ASSERT_EQ(runs.size(), 12u);
   for (const auto& run : runs) {
     EXPECT_TRUE(run.sensor_fault_run);
     EXPECT_FALSE(run.fault_channel.empty());
@@ -219,14 +220,15 @@ TEST(EvaluationRun, SensorFaultRunsAreNamedPerKindAndTheLeakIsFoundAfterwards) {
   int leak_runs = 0;
   for (const auto& score : scores) {
     SCOPED_TRACE(score.variant);
-    EXPECT_EQ(score.runs + score.never_seen, 1);
+    EXPECT_EQ(score.runs + score.never_seen, 2);
+    EXPECT_EQ(score.leak_runs, 1);  // each kind once with a leak opening during the fault
     EXPECT_EQ(score.named, score.runs);
     EXPECT_EQ(score.wrong_channel, 0);
     EXPECT_EQ(score.leakage_raised, 0);
     EXPECT_EQ(score.leak_found, score.leak_runs);
     leak_runs += score.leak_runs;
   }
-  EXPECT_EQ(leak_runs, 3);
+  EXPECT_EQ(leak_runs, 6);
   for (const auto& r : results) {
     // A spikes fault shows at its first spike, not at its start.
     if (r.spec.fault_kind == "spikes" && !std::isnan(r.spec.fault_seen)) {
