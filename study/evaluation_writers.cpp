@@ -18,6 +18,7 @@ constexpr double kLitresPerMinutePerMPa = 60000.0 * 1e6;  // m^3/(s Pa) -> l/min
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
 
 std::string percent_interval(int successes, int trials) {
+  if (trials == 0) return "0/0";
   const Interval ci = clopper_pearson_95(successes, trials);
   return fmt::format("{}/{} ({:.1f} %; 95 % CI {:.1f}-{:.1f} %)", successes, trials,
                      trials ? 100.0 * successes / trials : NAN, 100.0 * ci.lower, 100.0 * ci.upper);
