@@ -169,7 +169,11 @@ double SensorPlausibility::push(double value) noexcept {
     // A dropout to zeros that has just ended leaves no saturation behind (its zeros sat in the
     // bottom band too): the reading is back, not pinned at the range end.
     if (value != 0.0 && limits_.zero_is_dropout && zero_run_ >= limits_.dropout_run) band_run_ = 0;
-    band_run_ = in_band ? band_run_ + 1 : (band_run_ > kBandLeak ? band_run_ - kBandLeak : 0);
+    // Counted up to twice the saturation run only: enough margin for a noisy reading at the range
+    // end, and a channel that comes back after a long saturation is trusted again within
+    // 2 saturated_run / kBandLeak samples instead of a quarter of the fault's length.
+    band_run_ = in_band ? std::min(band_run_ + 1, 2 * limits_.saturated_run)
+                        : (band_run_ > kBandLeak ? band_run_ - kBandLeak : 0);
     zero_run_ = value == 0.0 ? zero_run_ + 1 : 0;
   }
   last_value_ = value;

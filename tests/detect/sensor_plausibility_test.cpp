@@ -296,6 +296,34 @@ TEST(SensorPlausibility, RecoversThroughMaintenanceRequiredToOk) {
   EXPECT_EQ(check.fault(), SensorFault::none);
 }
 
+// A minute at full scale: once the reading is back the stream is trusted again within a fraction
+// of a second and the channel is ok after the 2 s recovery, not a quarter of the fault later.
+TEST(SensorPlausibility, RecoversPromptlyAfterALongSaturation) {
+  capture::Capture capture = healthy("healthy", 52, 100.0);
+  auto& p1 = capture.column("p1");
+  const std::size_t from = 10'000, to = 40'000;  // saturated 20 s .. 80 s
+  for (std::size_t i = from; i < to; ++i) p1[i] = 4095.0 * lsb();
+  SensorPlausibility check(TransducerSpec::pressure(), kRate);
+  long trusted_at = -1, ok_at = -1;
+  for (std::size_t i = 0; i < p1.size(); ++i) {
+    check.push(p1[i]);
+    if (i == to - 1) {
+      EXPECT_EQ(check.fault(), SensorFault::saturated);
+    }
+    if (i >= to && trusted_at < 0 && check.status() != io::DeviceStatus::failure &&
+        !check.suspect()) {
+      trusted_at = static_cast<long>(i);
+    }
+    if (i >= to && ok_at < 0 && check.status() == io::DeviceStatus::ok) {
+      ok_at = static_cast<long>(i);
+    }
+  }
+  ASSERT_GE(ok_at, 0);
+  ASSERT_GE(trusted_at, 0);
+  EXPECT_LE(static_cast<double>(ok_at - static_cast<long>(to)) / kRate, 2.5);
+  EXPECT_LE(static_cast<double>(trusted_at - static_cast<long>(to)) / kRate, 2.5);
+}
+
 TEST(SensorPlausibility, PushAllocatesNothing) {
   const capture::Capture capture = healthy("healthy", 61, 10.0);
   auto p1 = capture.column("p1");
