@@ -75,9 +75,17 @@ int run_evaluate(int argc, char** argv) {
               "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
       .option("conditions", "LIST",
               "operating conditions the runs cycle through, comma-separated: stationary, warmup, "
-              "cooler, supply, sensor-faults (MODEL.md drifting conditions and sensor faults); "
-              "adds conditions.md and conditions.tsv",
+              "cooler, supply, sensor-faults, restart (MODEL.md drifting conditions and sensor "
+              "faults; restart: stopped after learning, restarted from the saved state after a "
+              "downtime in which the oil changed by 1-5 K and a leak run's leak opened); adds "
+              "conditions.md and conditions.tsv",
               "stationary")
+      .option("sensor-fault-runs", "N",
+              "extra runs with one sensor fault each (the six kinds in turn, each kind's runs "
+              "alternately with a 1e-12 leak opening during the fault), scored per fault kind in "
+              "conditions.md",
+              "0")
+      .option("after-restart", "S", "how long a healthy restart is watched", "300")
       .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
               "")
       .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
@@ -101,18 +109,21 @@ int run_evaluate(int argc, char** argv) {
       throw UsageError(fmt::format("option '--effects': {}", e.what()));
     }
   }
+  settings.sensor_fault_runs = static_cast<int>(args.get_int("sensor-fault-runs"));
+  settings.after_restart_seconds = args.get_double("after-restart");
   settings.conditions = split(args.get("conditions"));
   for (const auto& condition : settings.conditions) {
     if (!study::is_condition(condition)) {
       throw UsageError(fmt::format(
           "option '--conditions': unknown condition '{}' (known: stationary, warmup, cooler, "
-          "supply, sensor-faults)",
+          "supply, sensor-faults, restart)",
           condition));
     }
   }
   if (settings.conditions.empty()) settings.conditions = {"stationary"};
-  if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.jobs < 1) {
-    throw UsageError("run counts must be >= 0 and --jobs >= 1");
+  if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.sensor_fault_runs < 0 ||
+      settings.jobs < 1 || !(settings.after_restart_seconds > 0.0)) {
+    throw UsageError("run counts must be >= 0, --jobs >= 1 and --after-restart > 0");
   }
   if (settings.learn_seconds < 1 || settings.healthy_seconds < settings.learn_seconds + 10 ||
       settings.after_onset_seconds < settings.detect_within) {

@@ -17,8 +17,11 @@ constexpr double kFrozenSafety = 2.0;
 // 5 s in which a fault must be named.
 constexpr double kSaturatedSeconds = 0.25;
 constexpr double kDropoutSeconds = 0.25;
-// Two rejected spikes within a minute: interference, reported as "spikes". One is just rejected.
-constexpr double kSpikeWindowSeconds = 60.0;
+// A rejected spike is a fault at once: a sample off its neighbours by more than the noise floor
+// plus twice their range and back within one sample is no pressure or position the rig can
+// make (see the Hampel test in push()). The fault holds until the channel has been quiet this
+// long: interference comes a few times a minute, so a shorter hold would chatter between spikes.
+constexpr double kSpikeQuietSeconds = 60.0;
 // A fault's condition must stay away this long before the channel is ok again (the status is
 // maintenance_required meanwhile), so a flickering fault does not chatter.
 constexpr double kRecoverySeconds = 2.0;
@@ -93,7 +96,7 @@ PlausibilityLimits plausibility_limits(const TransducerSpec& spec, double sample
   }
   limits.saturated_run = samples(kSaturatedSeconds, sample_rate_hz);
   limits.dropout_run = samples(kDropoutSeconds, sample_rate_hz);
-  limits.spike_window = samples(kSpikeWindowSeconds, sample_rate_hz);
+  limits.spike_quiet = samples(kSpikeQuietSeconds, sample_rate_hz);
   limits.recovery = samples(kRecoverySeconds, sample_rate_hz);
   limits.spike_sigma = std::max(kSpikeSigmas * std::sqrt(sigma * sigma + q * q / 12.0), 2.0 * q);
   // A transducer whose range starts at or above 0 (pressure) reads exactly 0 only when it is
@@ -120,7 +123,11 @@ io::DeviceStatus SensorPlausibility::status() const {
 
 bool SensorPlausibility::suspect() const {
   if (!spec_.enabled) return false;
-  if (reported_ != SensorFault::none || band_run_ > 0) return true;
+  // Spikes alone leave the stream usable: each rejected sample has been replaced by its
+  // neighbours' median, so the leak decision goes on while the fault is reported.
+  if ((reported_ != SensorFault::none && reported_ != SensorFault::spikes) || band_run_ > 0) {
+    return true;
+  }
   if (limits_.zero_is_dropout && zero_run_ > 0) return true;
   return limits_.suspect_run > 0 && repeat_run_ >= limits_.suspect_run;
 }
@@ -133,7 +140,7 @@ SensorFault SensorPlausibility::condition() const {
   if (limits_.frozen_run > 0 && repeat_run_ >= limits_.frozen_run && band_run_ == 0) {
     return SensorFault::frozen;
   }
-  if (previous_spike_ != 0 && samples_ - previous_spike_ <= limits_.spike_window) {
+  if (last_spike_ != 0 && samples_ - last_spike_ <= limits_.spike_quiet) {
     return SensorFault::spikes;
   }
   return SensorFault::none;
@@ -159,7 +166,14 @@ double SensorPlausibility::push(double value) noexcept {
     repeat_run_ = value == last_value_ ? repeat_run_ + 1 : 1;
     const bool in_band =
         value <= spec_.min + 1.5 * spec_.resolution || value >= spec_.max - 1.5 * spec_.resolution;
-    band_run_ = in_band ? band_run_ + 1 : (band_run_ > kBandLeak ? band_run_ - kBandLeak : 0);
+    // A dropout to zeros that has just ended leaves no saturation behind (its zeros sat in the
+    // bottom band too): the reading is back, not pinned at the range end.
+    if (value != 0.0 && limits_.zero_is_dropout && zero_run_ >= limits_.dropout_run) band_run_ = 0;
+    // Counted up to twice the saturation run only: enough margin for a noisy reading at the range
+    // end, and a channel that comes back after a long saturation is trusted again within
+    // 2 saturated_run / kBandLeak samples instead of a quarter of the fault's length.
+    band_run_ = in_band ? std::min(band_run_ + 1, 2 * limits_.saturated_run)
+                        : (band_run_ > kBandLeak ? band_run_ - kBandLeak : 0);
     zero_run_ = value == 0.0 ? zero_run_ + 1 : 0;
   }
   last_value_ = value;
@@ -186,7 +200,6 @@ double SensorPlausibility::push(double value) noexcept {
           out = median;
           history_[centre] = median;  // later tests see the cleaned value as a neighbour
           ++spikes_rejected_;
-          previous_spike_ = last_spike_;
           last_spike_ = samples_ - kDelay;
         }
       }

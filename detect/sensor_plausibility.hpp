@@ -47,10 +47,10 @@ struct PlausibilityLimits {
   std::uint32_t suspect_run = 0;  // exact repeats after which the stream is not trusted
   std::uint32_t saturated_run = 0;
   std::uint32_t dropout_run = 0;
-  std::uint32_t spike_window = 0;  // a second spike within this many samples: "spikes"
-  std::uint32_t recovery = 0;      // fault-free samples before the status returns to ok
-  double spike_sigma = 0.0;        // Hampel threshold floor [channel unit]
-  bool zero_is_dropout = false;    // 0 is the bottom of the range: exact zeros mean no signal
+  std::uint32_t spike_quiet = 0;  // "spikes" from a rejected spike until this many quiet samples
+  std::uint32_t recovery = 0;     // fault-free samples before the status returns to ok
+  double spike_sigma = 0.0;       // Hampel threshold floor [channel unit]
+  bool zero_is_dropout = false;   // 0 is the bottom of the range: exact zeros mean no signal
 };
 
 PlausibilityLimits plausibility_limits(const TransducerSpec& spec, double sample_rate_hz);
@@ -74,8 +74,9 @@ class SensorPlausibility {
   // ok; failure / out_of_specification while a fault is active; maintenance_required while
   // recovering (the output is valid again, but the channel has just been faulty).
   io::DeviceStatus status() const;
-  // True while a fault is reported or a condition is building up (a run of repeats, values at a
-  // range end, gaps): the stream must not teach or drive a detector then.
+  // True while a fault other than spikes is reported or a condition is building up (a run of
+  // repeats, values at a range end, gaps): the stream must not teach or drive a detector then.
+  // Spikes are replaced sample by sample, so they do not make the stream suspect.
   bool suspect() const;
 
   std::uint64_t spikes_rejected() const { return spikes_rejected_; }
@@ -95,7 +96,7 @@ class SensorPlausibility {
   std::uint32_t band_run_ = 0;    // consecutive samples within one LSB of a range end
   std::uint32_t zero_run_ = 0;    // consecutive exact zeros (when zero_is_dropout)
   std::uint32_t nan_run_ = 0;
-  std::uint64_t last_spike_ = 0, previous_spike_ = 0;  // sample numbers + 1; 0: none
+  std::uint64_t last_spike_ = 0;  // sample number of the last rejected spike; 0: none
   std::uint64_t spikes_rejected_ = 0;
 
   SensorFault active_ = SensorFault::none;

@@ -32,11 +32,45 @@ sim::Scenario draw_rig(std::mt19937_64& rng, int id, std::uint64_t seed, double 
   return s;
 }
 
+// One fault of p1, p2 or x of kind `kind` (drawn when < 0; 0 frozen, 1 saturated high, 2 saturated
+// low, 3 spikes, 4 dropout to zero, 5 dropout to gaps), 10-60 s, starting 10 s or more after `from`
+// and ending 10 s or more before `to` where there is room.
+void draw_sensor_fault(std::mt19937_64& rng, int kind, double from, double to, RunSpec& run) {
+  sim::SensorFault fault;
+  const sim::SensorChannel channels[] = {sim::SensorChannel::p1, sim::SensorChannel::p2,
+                                         sim::SensorChannel::x};
+  fault.channel = channels[std::uniform_int_distribution<int>(0, 2)(rng)];
+  if (kind < 0) kind = std::uniform_int_distribution<int>(0, 5)(rng);
+  fault.kind = kind == 0   ? sim::SensorFault::Kind::frozen
+               : kind <= 2 ? sim::SensorFault::Kind::saturated
+               : kind == 3 ? sim::SensorFault::Kind::spikes
+                           : sim::SensorFault::Kind::dropout;
+  fault.high = kind == 1;
+  fault.gap = kind == 5;
+  fault.duration_s = uniform(rng, 10.0, 60.0);
+  fault.start_s = uniform(rng, from + 10.0, std::max(from + 10.0, to - fault.duration_s - 10.0));
+  // Spikes: a few per minute, MODEL.md; off by MPa on a pressure, by millimetres on x.
+  fault.rate_per_min = uniform(rng, 3.0, 10.0);
+  fault.magnitude =
+      fault.channel == sim::SensorChannel::x ? uniform(rng, 2e-3, 1e-2) : uniform(rng, 1e6, 4e6);
+  run.fault_channel = std::string(sim::to_string(fault.channel));
+  run.fault_kind = std::string(sim::to_string(fault.kind));
+  run.fault_variant = run.fault_kind;
+  if (fault.kind == sim::SensorFault::Kind::saturated)
+    run.fault_variant += fault.high ? "_high" : "_low";
+  if (fault.kind == sim::SensorFault::Kind::dropout)
+    run.fault_variant += fault.gap ? "_gap" : "_zero";
+  run.fault_start = fault.start_s;
+  run.fault_end = fault.start_s + fault.duration_s;
+  run.fault_seen = fault.start_s;
+  run.scenario.faults.push_back(fault);
+}
+
 // Draws the operating condition's parameters onto the scenario (MODEL.md "Drifting operating
 // conditions" and "Sensor faults"), from its own stream so the rig draws of the other runs stay
 // as they are. `healthy_from`..`healthy_to` is where a sensor fault may sit.
 void apply_operating(const std::string& operating, std::mt19937_64& rng, double healthy_from,
-                     double healthy_to, RunSpec& run) {
+                     double healthy_to, const EvaluationOptions& options, RunSpec& run) {
   if (operating == "stationary") return;
   sim::Scenario& s = run.scenario;
   s.record.temp = true;
@@ -74,30 +108,38 @@ void apply_operating(const std::string& operating, std::mt19937_64& rng, double 
       s.conditions.supply.push_back({t, uniform(rng, 13e6, 20e6), ramp});
       t += ramp;
     }
-  } else if (operating == "sensor-faults") {
-    sim::SensorFault fault;
-    const sim::SensorChannel channels[] = {sim::SensorChannel::p1, sim::SensorChannel::p2,
-                                           sim::SensorChannel::x};
-    fault.channel = channels[std::uniform_int_distribution<int>(0, 2)(rng)];
-    const int kind = std::uniform_int_distribution<int>(0, 5)(rng);
-    fault.kind = kind == 0   ? sim::SensorFault::Kind::frozen
-                 : kind <= 2 ? sim::SensorFault::Kind::saturated
-                 : kind == 3 ? sim::SensorFault::Kind::spikes
-                             : sim::SensorFault::Kind::dropout;
-    fault.high = kind == 1;
-    fault.gap = kind == 5;
-    fault.duration_s = uniform(rng, 10.0, 60.0);
-    fault.start_s = uniform(rng, healthy_from + 10.0,
-                            std::max(healthy_from + 10.0, healthy_to - fault.duration_s - 10.0));
-    // Spikes: a few per minute, MODEL.md; off by MPa on a pressure, by millimetres on x.
-    fault.rate_per_min = uniform(rng, 3.0, 10.0);
-    fault.magnitude =
-        fault.channel == sim::SensorChannel::x ? uniform(rng, 2e-3, 1e-2) : uniform(rng, 1e6, 4e6);
-    run.fault_channel = std::string(sim::to_string(fault.channel));
-    run.fault_kind = std::string(sim::to_string(fault.kind));
-    run.fault_start = fault.start_s;
-    run.fault_end = fault.start_s + fault.duration_s;
-    s.faults.push_back(fault);
+  } else if (operating == "sensor-faults" && !run.sensor_fault_run) {
+    draw_sensor_fault(rng, -1, healthy_from, healthy_to, run);
+  } else if (operating == "restart") {
+    // Learning and a monitored stretch at a steady temperature, then the daemon stops and its
+    // state is saved; the rig runs on while it is down, the oil warming or cooling by 1-5 K (a
+    // rig that was switched off cools, one that kept working may warm) and, in a leak run, the
+    // leak opening; the daemon restarts on the rig as it is then.
+    const double temp_before = uniform(rng, 40.0, 50.0);
+    const double change = (rng() % 2 == 0 ? 1.0 : -1.0) * uniform(rng, 1.0, 5.0);
+    profile.kind = sim::TemperatureProfile::Kind::constant;
+    profile.T_work = temp_before;
+    s.conditions.temperature = profile;
+    run.temp_before = temp_before;
+    run.temp_after = temp_before + change;
+    run.stop_at = healthy_from + uniform(rng, 30.0, 120.0);
+    run.downtime = uniform(rng, 10.0, 1800.0);
+    run.restart_at = run.stop_at + run.downtime;
+    sim::Scenario after = s;
+    after.seed = s.seed ^ 0x3c6ef372fe94f82bULL;  // the rig's noise and moves go on, not repeat
+    after.conditions.temperature->T_work = run.temp_after;
+    after.name += "-restarted";
+    if (run.leak > 0.0) {
+      after.effects.internal_leakage = sim::InternalLeakage{run.leak, 0.0, 0.0};
+      after.duration_s = options.after_onset_seconds;
+      run.onset = run.restart_at;
+    } else {
+      after.effects.internal_leakage.reset();
+      after.duration_s = options.after_restart_seconds;
+    }
+    s.effects.internal_leakage.reset();
+    s.duration_s = run.stop_at;
+    run.after_restart = after;
   }
 }
 
@@ -125,6 +167,11 @@ std::vector<Condition> plan_conditions(const EvaluationOptions& options) {
       plan.push_back({LeakCondition{leak, options.after_onset_seconds}, options.effects, pick(i)});
     }
   }
+  for (int i = 0; i < options.sensor_fault_runs; ++i) {
+    plan.push_back({SensorFaultCondition{(i / 6) % 2 == 1 ? kSensorFaultLeak : 0.0,
+                                         options.after_fault_seconds, i % 6},
+                    options.effects, "sensor-faults"});
+  }
   return plan;
 }
 
@@ -142,6 +189,10 @@ RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
                  [&](const HealthyCondition& healthy) {
                    run.scenario = draw_rig(rig_draws, id, seed, healthy.seconds, condition.effects);
                  },
+                 [&](const SensorFaultCondition&) {
+                   run.scenario =
+                       draw_rig(rig_draws, id, seed, run.monitor_from, condition.effects);
+                 },
                  [&](const LeakCondition& leak) {
                    run.leak = leak.coefficient;
                    // A healthy stretch after learning (false alarms count there too), then the
@@ -155,8 +206,20 @@ RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
              },
              condition.kind);
   std::mt19937_64 operating_draws(seed ^ 0x6a09e667f3bcc909ULL);
+  run.sensor_fault_run = std::holds_alternative<SensorFaultCondition>(condition.kind);
   apply_operating(condition.operating, operating_draws, run.monitor_from,
-                  std::min(run.onset, run.scenario.duration_s), run);
+                  std::min(run.onset, run.scenario.duration_s), options, run);
+  if (const auto* fault = std::get_if<SensorFaultCondition>(&condition.kind)) {
+    // A fault 10-40 s into monitoring; in a leak run the leak opens while it lasts.
+    const double start = run.monitor_from + uniform(operating_draws, 0.0, 30.0);
+    draw_sensor_fault(operating_draws, fault->kind, start, start, run);
+    if (fault->coefficient > 0.0) {
+      run.leak = fault->coefficient;
+      run.onset = uniform(operating_draws, run.fault_start, run.fault_end);
+      run.scenario.effects.internal_leakage = sim::InternalLeakage{run.leak, run.onset, 0.0};
+    }
+    run.scenario.duration_s = run.fault_end + fault->after_fault_seconds;
+  }
   return run;
 }
 

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 #include <variant>
@@ -29,8 +30,18 @@ struct LeakCondition {
   double after_onset_seconds = 0.0;
 };
 
+// A sensor fault of one transducer (its kind drawn) after learning; with `coefficient` > 0 an
+// internal leak of that C_L opens during the fault. The run goes on for `after_fault_seconds`
+// after the fault has cleared, so that one sees the leak decision work again.
+struct SensorFaultCondition {
+  double coefficient = 0.0;
+  double after_fault_seconds = 0.0;
+  // 0 frozen, 1 saturated high, 2 saturated low, 3 spikes, 4 dropout to zero, 5 dropout to gaps
+  int kind = 0;
+};
+
 struct Condition {
-  using Kind = std::variant<HealthyCondition, LeakCondition>;
+  using Kind = std::variant<HealthyCondition, LeakCondition, SensorFaultCondition>;
   Kind kind;
   std::vector<std::string> effects;      // MODEL.md effects on from the start (default parameters)
   std::string operating = "stationary";  // one of kConditionNames: how the rig drifts
@@ -46,11 +57,29 @@ struct RunSpec {
   double monitor_from = 0;  // end of settle + learning [s]
   // sensor-faults: the injected fault (channel name and kind as the alarm names them), and when.
   std::string fault_channel, fault_kind;
+  std::string fault_variant;  // kind with its variant: saturated_high/_low, dropout_zero/_gap
   double fault_start = NAN, fault_end = NAN;
+  // When the fault first shows in the capture: its start, or the first spike (set by the runner,
+  // which knows the injected spikes).
+  double fault_seen = NAN;
+  // A SensorFaultCondition run: scored per fault kind (write_condition_summaries), not in the
+  // generic tables (its leak opens inside a fault on purpose).
+  bool sensor_fault_run = false;
+  // restart: the daemon is stopped at `stop_at` (the end of `scenario`, after which its state is
+  // saved) and started again `downtime` seconds later on `after_restart`, a capture of the same
+  // rig from then on (its leak, if any, opened during the downtime), resuming what it learned.
+  // Times after the restart are stated on the first capture's clock: restart_at = stop_at +
+  // downtime. `onset` is restart_at for a leak run, so "detected within 60 s" means of the restart.
+  std::optional<sim::Scenario> after_restart;
+  double stop_at = NAN, restart_at = NAN, downtime = NAN;
+  double temp_before = NAN, temp_after = NAN;  // oil temperature [degC] before and after
 };
 
 // The evaluation's conditions in run order: healthy_runs healthy runs, then runs_per_leak leak
-// runs per leak size, each with the options' effects.
+// runs per leak size, each with the options' effects, then sensor_fault_runs SensorFaultCondition
+// runs: the kinds in turn, each kind's runs alternately without and with a leak of
+// kSensorFaultLeak opening during the fault.
+inline constexpr double kSensorFaultLeak = 1e-12;
 std::vector<Condition> plan_conditions(const EvaluationOptions& options);
 
 // Seed of run `id`'s simulation (noise, reference) in a study with master seed `seed`.

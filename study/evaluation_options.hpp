@@ -27,6 +27,12 @@ struct EvaluationOptions {
   // MODEL.md's stationary rig at 40 degC). Runs under any other condition record `temp` and
   // `ps`, and candidates choose whether to use them.
   std::vector<std::string> conditions = {"stationary"};
+  // Runs dedicated to sensor faults (scored per fault kind): a fault after learning, a leak
+  // opening during it in every second run, and this long after the fault.
+  int sensor_fault_runs = 0;
+  double after_fault_seconds = 90.0;
+  // restart: how long the daemon watches a healthy rig after restarting.
+  double after_restart_seconds = 300.0;
   std::vector<int> keep_captures;  // run ids whose capture CSV is written into `out`
   std::filesystem::path out;
 };
@@ -49,10 +55,12 @@ std::vector<Candidate> candidates();
 // The conditions `--conditions` takes: stationary, warmup (a morning warm-up from 15-35 degC to
 // 45-55 degC, time constant 5-20 min, learning during it), cooler (a warm rig cycling +-1-4 K
 // every 5-20 min), supply (one or two set-point changes to 13-20 MPa), sensor-faults (one fault
-// of one transducer: frozen, saturated, spikes or dropout, 10-60 s), each with an oil grade VG
-// 32, 46 or 68.
-inline constexpr std::string_view kConditionNames[] = {"stationary", "warmup", "cooler", "supply",
-                                                       "sensor-faults"};
+// of one transducer: frozen, saturated, spikes or dropout, 10-60 s), restart (the daemon stopped
+// after learning and restarted from its saved state after a downtime of 10 s-30 min in which
+// the oil warmed or cooled by 1-5 K and, in leak runs, the leak opened), each with an oil grade
+// VG 32, 46 or 68.
+inline constexpr std::string_view kConditionNames[] = {"stationary", "warmup",        "cooler",
+                                                       "supply",     "sensor-faults", "restart"};
 bool is_condition(std::string_view name);
 
 // Position of the design threshold in `raise_thresholds` (its size when absent).

@@ -2,8 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -13,6 +17,8 @@
 
 #include "daemon/replay.hpp"
 #include "detect/factory.hpp"
+#include "sim/random.hpp"
+#include "sim/sensor_faults.hpp"
 #include "sim/simulate.hpp"
 
 namespace leakmon::study {
@@ -51,6 +57,62 @@ SizeCheck check_size(const capture::Capture& capture, const RunSpec& spec,
     break;
   }
   return check;
+}
+
+// When a spikes fault first shows: the first sample the injected spikes change. The fault's
+// random stream is replayed on constant readings (it draws the same numbers whatever the
+// readings are), so the plant need not be simulated again.
+double first_spike(const sim::Scenario& scenario) {
+  for (const sim::SensorFault& fault : scenario.faults) {
+    if (fault.kind != sim::SensorFault::Kind::spikes) continue;
+    sim::SensorFaults faults(scenario.faults, scenario.sensors, 0.5 * scenario.params.L,
+                             sim::stream_seed(scenario.seed, sim::RandomStream::sensor_faults));
+    const double period = 1.0 / scenario.sample_rate_hz;
+    const sim::Readings steady{10e6, 10e6, 0.0, 17e6, 40.0};
+    const double end = std::min(fault.start_s + fault.duration_s, scenario.duration_s);
+    for (auto k = static_cast<std::int64_t>(std::max(0.0, fault.start_s / period - 1.0));; ++k) {
+      const double t = static_cast<double>(k) * period;
+      if (t >= end) break;
+      sim::Readings r = steady;
+      faults.apply(t, period, r);
+      if (r[fault.channel] != sim::Readings(steady)[fault.channel]) return t;
+    }
+    return NAN;  // no spike came in the fault's time
+  }
+  return NAN;
+}
+
+// Alarms of one replay into `result`, their times shifted by `offset` (a restarted replay's
+// clock starts at the restart).
+void collect_alarms(const daemon::ReplayResult& replay, double offset, RunResult& result) {
+  const auto all = candidates();
+  std::map<std::string, std::pair<std::size_t, std::size_t>> by_name;
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    for (std::size_t t = 0; t < all[c].raise_thresholds.size(); ++t) {
+      by_name[actuator_name(c, t)] = {c, t};
+    }
+  }
+  const std::string sensor_actuator =
+      actuator_name(kSensorCandidate, design_index(all[kSensorCandidate]));
+  for (const auto& event : replay.events) {
+    if (event.kind == io::EventKind::state_restored) ++result.states_restored;
+    if (event.kind != io::EventKind::alarm_raised) continue;
+    if (event.alarm == "sensor_fault") {
+      if (event.actuator == sensor_actuator)
+        result.sensor_alarms.push_back({event.t + offset, event.channel, event.fault});
+      continue;
+    }
+    const auto found = by_name.find(event.actuator);
+    if (found == by_name.end()) continue;
+    result.alarms[found->second.first][found->second.second].push_back(
+        {event.t + offset, event.leak_coefficient});
+  }
+}
+
+// A directory of its own for one run's saved state (several runs replay at once).
+std::filesystem::path state_directory(const RunSpec& spec) {
+  return std::filesystem::temp_directory_path() /
+         fmt::format("leakmon-evaluate-{}-{}-{}", ::getpid(), spec.id, spec.scenario.seed);
 }
 
 }  // namespace
@@ -93,40 +155,51 @@ daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
 RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
   RunResult result;
   result.spec = spec;
+  const auto all = candidates();
+  result.alarms.resize(all.size());
+  for (std::size_t c = 0; c < all.size(); ++c)
+    result.alarms[c].resize(all[c].raise_thresholds.size());
+  if (spec.fault_kind == "spikes") result.spec.fault_seen = first_spike(spec.scenario);
+
   const capture::Capture capture = sim::simulate(spec.scenario);
   if (std::find(options.keep_captures.begin(), options.keep_captures.end(), spec.id) !=
       options.keep_captures.end()) {
     capture::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
   }
-  const daemon::ReplayResult replay =
-      daemon::replay_capture(capture, evaluation_config(capture, options));
-  if (spec.leak > 0.0) {
-    result.size_check = check_size(capture, spec, options, detector_options(options));
-  }
-  const auto all = candidates();
-  result.alarms.resize(all.size());
-  std::map<std::string, std::pair<std::size_t, std::size_t>> by_name;
-  for (std::size_t c = 0; c < all.size(); ++c) {
-    result.alarms[c].resize(all[c].raise_thresholds.size());
-    for (std::size_t t = 0; t < all[c].raise_thresholds.size(); ++t) {
-      by_name[actuator_name(c, t)] = {c, t};
+  if (!spec.after_restart) {
+    collect_alarms(daemon::replay_capture(capture, evaluation_config(capture, options)), 0.0,
+                   result);
+    if (spec.leak > 0.0) {
+      result.size_check = check_size(capture, spec, options, detector_options(options));
     }
+    result.seconds = spec.scenario.duration_s;
+    return result;
   }
-  const std::string sensor_actuator =
-      actuator_name(kSensorCandidate, design_index(all[kSensorCandidate]));
-  for (const auto& event : replay.events) {
-    if (event.kind != io::EventKind::alarm_raised) continue;
-    if (event.alarm == "sensor_fault") {
-      if (event.actuator == sensor_actuator)
-        result.sensor_alarms.push_back({event.t, event.channel, event.fault});
-      continue;
+
+  // A restart: the first capture replayed as the daemon ran until it stopped (saving its state
+  // at the end, as at shutdown), the second as the daemon started again on that state.
+  const std::filesystem::path directory = state_directory(spec);
+  std::filesystem::remove_all(directory);
+  daemon::ReplayOptions replay_options;
+  replay_options.state_directory = directory.string();
+  try {
+    collect_alarms(
+        daemon::replay_capture(capture, evaluation_config(capture, options), replay_options), 0.0,
+        result);
+    const capture::Capture after = sim::simulate(*spec.after_restart);
+    if (std::find(options.keep_captures.begin(), options.keep_captures.end(), spec.id) !=
+        options.keep_captures.end()) {
+      capture::write_capture((options.out / fmt::format("run-{}-restarted.csv", spec.id)).string(),
+                             after);
     }
-    const auto found = by_name.find(event.actuator);
-    if (found == by_name.end()) continue;
-    result.alarms[found->second.first][found->second.second].push_back(
-        {event.t, event.leak_coefficient});
+    collect_alarms(daemon::replay_capture(after, evaluation_config(after, options), replay_options),
+                   spec.restart_at, result);
+    result.seconds = spec.restart_at + spec.after_restart->duration_s;
+  } catch (...) {
+    std::filesystem::remove_all(directory);
+    throw;
   }
-  result.seconds = spec.scenario.duration_s;
+  std::filesystem::remove_all(directory);
   return result;
 }
 

@@ -8,9 +8,9 @@
 #include <functional>
 #include <vector>
 
+#include "capture/capture.hpp"
 #include "config/yaml_reader.hpp"
 #include "daemon/config.hpp"
-#include "capture/capture.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
 
@@ -46,6 +46,8 @@ struct RunResult {
   std::vector<std::vector<std::vector<Alarm>>> alarms;
   double seconds = 0.0;
   std::vector<SensorAlarm> sensor_alarms;
+  // restart runs: actuators that resumed their saved state at the restart (0: none did).
+  int states_restored = 0;
 };
 
 // The learning and settling periods every candidate's detector is configured with.

@@ -95,7 +95,12 @@ void add_run(Rates& rates, const RunResult& run, std::size_t candidate, std::siz
   const double healthy_end = std::min(spec.onset, run.seconds);
   const auto& alarms = run.alarms[candidate][threshold];
   if (include_healthy) {
-    rates.healthy_hours += std::max(0.0, healthy_end - spec.monitor_from) / 3600.0;
+    double monitored = std::max(0.0, healthy_end - spec.monitor_from);
+    // A restart's downtime is no monitored time.
+    if (!std::isnan(spec.downtime) && healthy_end > spec.stop_at) {
+      monitored -= std::min(spec.downtime, healthy_end - spec.stop_at);
+    }
+    rates.healthy_hours += monitored / 3600.0;
     for (const auto& a : alarms) {
       if (a.raised < healthy_end) ++rates.false_alarms;
     }
@@ -121,7 +126,7 @@ Rates rates_of(const std::vector<RunResult>& results, std::size_t candidate, std
                std::string_view controller, double leak, double detect_within) {
   Rates rates;
   for (const auto& r : results) {
-    if (!in_group(r, controller)) continue;
+    if (!in_group(r, controller) || r.spec.sensor_fault_run) continue;
     const bool leak_match = leak == 0.0 || r.spec.leak == leak;
     add_run(rates, r, candidate, threshold, detect_within, true, leak_match);
   }
@@ -137,6 +142,7 @@ Coverage coverage_of(const std::vector<RunResult>& results, std::string_view con
   Coverage coverage;
   for (const auto& r : results) {
     if (r.spec.leak != leak || std::isnan(r.size_check.leak_coefficient)) continue;
+    if (r.spec.sensor_fault_run) continue;
     if (!in_group(r, controller)) continue;
     ++coverage.raised;
     coverage.covered += r.size_check.covers(leak) ? 1 : 0;
@@ -144,6 +150,126 @@ Coverage coverage_of(const std::vector<RunResult>& results, std::string_view con
   }
   std::sort(coverage.relative_half_widths.begin(), coverage.relative_half_widths.end());
   return coverage;
+}
+
+std::vector<SensorFaultScore> score_sensor_faults(const std::vector<RunResult>& results,
+                                                  double detect_within) {
+  std::vector<SensorFaultScore> scores;
+  const std::size_t t = design_index(candidates()[kSensorCandidate]);
+  for (const auto& r : results) {
+    const RunSpec& spec = r.spec;
+    if (spec.fault_channel.empty()) continue;
+    auto found = std::find_if(scores.begin(), scores.end(), [&](const SensorFaultScore& score) {
+      return score.variant == spec.fault_variant;
+    });
+    if (found == scores.end()) {
+      SensorFaultScore score;
+      score.variant = spec.fault_variant;
+      scores.push_back(score);
+      found = scores.end() - 1;
+    }
+    SensorFaultScore& score = *found;
+    if (std::isnan(spec.fault_seen)) {
+      ++score.never_seen;  // a spikes fault too short for any spike: nothing to name
+    } else {
+      ++score.runs;
+      double first = NAN;
+      bool right_kind = false;
+      for (const auto& a : r.sensor_alarms) {
+        if (a.t < spec.fault_start || a.t > spec.fault_end + kNamedWithinSeconds) continue;
+        if (a.channel != spec.fault_channel) {
+          ++score.wrong_channel;
+          continue;
+        }
+        if (std::isnan(first)) {
+          first = a.t;
+          right_kind = a.fault == spec.fault_kind;
+        }
+      }
+      const double latency = first - spec.fault_seen;
+      if (!std::isnan(first) && latency <= kNamedWithinSeconds) {
+        ++score.named;
+        score.right_kind += right_kind ? 1 : 0;
+        score.latencies.push_back(latency);
+      }
+    }
+    // internal_leakage while the fault lasts or after it, before any leak has opened.
+    for (const auto& a : r.alarms[kSensorCandidate][t]) {
+      if (a.raised >= spec.fault_start && a.raised < spec.onset) {
+        ++score.leakage_raised;
+        break;
+      }
+    }
+    if (spec.leak > 0.0 && spec.onset >= spec.fault_start && spec.onset < spec.fault_end) {
+      ++score.leak_runs;
+      for (const auto& a : r.alarms[kSensorCandidate][t]) {
+        if (a.raised < spec.onset) continue;
+        if (a.raised <= spec.fault_end + detect_within) {
+          ++score.leak_found;
+          score.leak_delays_after_fault.push_back(a.raised - spec.fault_end);
+        }
+        break;
+      }
+    }
+  }
+  std::sort(scores.begin(), scores.end(),
+            [](const auto& a, const auto& b) { return a.variant < b.variant; });
+  return scores;
+}
+
+SensorAlarmsWithoutFault sensor_alarms_without_fault(const std::vector<RunResult>& results) {
+  SensorAlarmsWithoutFault out;
+  for (const auto& r : results) {
+    if (!r.spec.fault_channel.empty()) continue;
+    double monitored = r.seconds;
+    if (!std::isnan(r.spec.downtime)) monitored -= r.spec.downtime;
+    out.hours += monitored / 3600.0;
+    out.alarms += static_cast<int>(r.sensor_alarms.size());
+  }
+  return out;
+}
+
+RestartScore score_restarts(const std::vector<RunResult>& results, std::size_t candidate,
+                            double detect_within) {
+  RestartScore score;
+  const std::size_t t = design_index(candidates()[candidate]);
+  for (const auto& r : results) {
+    const RunSpec& spec = r.spec;
+    if (std::isnan(spec.restart_at)) continue;
+    score.restored += r.states_restored > 0 ? 1 : 0;
+    const auto& alarms = r.alarms[candidate][t];
+    for (const auto& a : alarms) {
+      if (a.raised >= spec.monitor_from && a.raised < spec.stop_at) {
+        ++score.raised_before_stop;
+        break;
+      }
+    }
+    const bool warmer = spec.temp_after > spec.temp_before;
+    if (spec.leak > 0.0) {
+      ++score.leak_runs;
+      (warmer ? score.leak_runs_warmer : score.leak_runs_cooler) += 1;
+      for (const auto& a : alarms) {
+        if (a.raised < spec.restart_at) continue;
+        if (a.raised - spec.restart_at <= detect_within) {
+          ++score.found;
+          (warmer ? score.found_warmer : score.found_cooler) += 1;
+          score.delays.push_back(a.raised - spec.restart_at);
+        }
+        break;
+      }
+    } else {
+      ++score.healthy_runs;
+      score.healthy_hours_after += (r.seconds - spec.restart_at) / 3600.0;
+      for (const auto& a : alarms) {
+        if (a.raised >= spec.restart_at) {
+          ++score.healthy_raised;
+          break;
+        }
+      }
+    }
+  }
+  std::sort(score.delays.begin(), score.delays.end());
+  return score;
 }
 
 }  // namespace leakmon::study

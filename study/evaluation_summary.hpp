@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -58,6 +59,49 @@ struct Coverage {
 };
 Coverage coverage_of(const std::vector<RunResult>& results, std::string_view controller,
                      double leak);
+
+// Sensor faults per kind and variant (frozen, saturated_high/_low, spikes, dropout_zero/_gap),
+// for every run with a fault, scored on the daemon's default actuator at its design threshold
+// (kSensorCandidate): named when a sensor_fault alarm on the faulty channel comes within
+// kNamedWithinSeconds of the fault showing (its start; spikes: the first spike).
+inline constexpr double kNamedWithinSeconds = 5.0;
+struct SensorFaultScore {
+  std::string variant;
+  int runs = 0;            // faults that showed
+  int never_seen = 0;      // spikes faults without a single spike in their time
+  int named = 0;           // on the right channel within kNamedWithinSeconds
+  int right_kind = 0;      // of those, with the injected kind as the first fault named
+  int wrong_channel = 0;   // sensor_fault alarms on other channels during the fault (+5 s)
+  int leakage_raised = 0;  // runs with internal_leakage from the fault's start on, before any leak
+  int leak_runs = 0;       // runs whose leak opened during the fault
+  int leak_found = 0;      // ... found after its onset and within detect_within of the fault's end
+  std::vector<double> latencies;                // naming after the fault showed [s]
+  std::vector<double> leak_delays_after_fault;  // raise - fault end [s] (negative: during it)
+};
+std::vector<SensorFaultScore> score_sensor_faults(const std::vector<RunResult>& results,
+                                                  double detect_within);
+
+// sensor_fault alarms in runs without a fault, over their monitored time.
+struct SensorAlarmsWithoutFault {
+  int alarms = 0;
+  double hours = 0.0;
+};
+SensorAlarmsWithoutFault sensor_alarms_without_fault(const std::vector<RunResult>& results);
+
+// Restart runs of one candidate at its design threshold: leaks that opened during the downtime
+// found within detect_within of the restart, and healthy restarts that raised internal_leakage
+// after the restart.
+struct RestartScore {
+  int leak_runs = 0, found = 0;
+  int leak_runs_warmer = 0, found_warmer = 0, leak_runs_cooler = 0, found_cooler = 0;
+  std::vector<double> delays;  // after the restart, ascending
+  int healthy_runs = 0, healthy_raised = 0;
+  double healthy_hours_after = 0.0;
+  int raised_before_stop = 0;  // runs with internal_leakage before the daemon stopped (healthy)
+  int restored = 0;            // runs in which the restarted replay resumed saved state
+};
+RestartScore score_restarts(const std::vector<RunResult>& results, std::size_t candidate,
+                            double detect_within);
 
 // The controller groups the summaries report: "all" and each controller.
 inline constexpr std::array<std::string_view, 3> kControllerGroups = {"all", "basic",

@@ -4,6 +4,7 @@
 #include <fmt/os.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -15,6 +16,91 @@ namespace {
 constexpr double kLitresPerMinutePerMPa = 60000.0 * 1e6;  // m^3/(s Pa) -> l/min/MPa
 
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+
+std::string percent_interval(int successes, int trials) {
+  if (trials == 0) return "0/0";
+  const Interval ci = clopper_pearson_95(successes, trials);
+  return fmt::format("{}/{} ({:.1f} %; 95 % CI {:.1f}-{:.1f} %)", successes, trials,
+                     trials ? 100.0 * successes / trials : NAN, 100.0 * ci.lower, 100.0 * ci.upper);
+}
+
+std::string median_text(std::vector<double> v, const char* unit) {
+  if (v.empty()) return "-";
+  std::sort(v.begin(), v.end());
+  return fmt::format("{:.2f}{}", v[v.size() / 2], unit);
+}
+
+// Per fault kind: named on the right channel within 5 s, other channels, internal_leakage, and
+// the leak decision after the fault.
+void write_sensor_fault_table(fmt::ostream& f, const std::vector<RunResult>& results,
+                              double detect_within) {
+  const auto scores = score_sensor_faults(results, detect_within);
+  if (scores.empty()) return;
+  f.print(
+      "\nSensor faults (the default detector's actuator; named = a sensor_fault alarm on the "
+      "faulty channel within {:.0f} s of the fault showing, spikes: of the first spike):\n\n"
+      "| fault | runs | named within {:.0f} s (95 % CI) | kind named right | median latency | "
+      "alarms on other channels | internal_leakage raised | leak opened in the fault, found "
+      "within {:.0f} s of its end | median delay after the end |\n"
+      "|---|---|---|---|---|---|---|---|---|\n",
+      kNamedWithinSeconds, kNamedWithinSeconds, detect_within);
+  SensorFaultScore total;
+  total.variant = "all";
+  for (const auto& score : scores) {
+    total.runs += score.runs;
+    total.never_seen += score.never_seen;
+    total.named += score.named;
+    total.right_kind += score.right_kind;
+    total.wrong_channel += score.wrong_channel;
+    total.leakage_raised += score.leakage_raised;
+    total.leak_runs += score.leak_runs;
+    total.leak_found += score.leak_found;
+    total.latencies.insert(total.latencies.end(), score.latencies.begin(), score.latencies.end());
+    total.leak_delays_after_fault.insert(total.leak_delays_after_fault.end(),
+                                         score.leak_delays_after_fault.begin(),
+                                         score.leak_delays_after_fault.end());
+  }
+  auto row = [&](const SensorFaultScore& score) {
+    f.print("| {} | {}{} | {} | {}/{} | {} | {} | {}/{} | {}/{} | {} |\n", score.variant,
+            score.runs,
+            score.never_seen ? fmt::format(" (+{} without a spike)", score.never_seen) : "",
+            percent_interval(score.named, score.runs), score.right_kind, score.named,
+            median_text(score.latencies, " s"), score.wrong_channel, score.leakage_raised,
+            score.runs + score.never_seen, score.leak_found, score.leak_runs,
+            median_text(score.leak_delays_after_fault, " s"));
+  };
+  for (const auto& score : scores) row(score);
+  row(total);
+  const SensorAlarmsWithoutFault clean = sensor_alarms_without_fault(results);
+  f.print("\nsensor_fault alarms in runs without a fault: {} in {:.1f} monitored h.\n",
+          clean.alarms, clean.hours);
+}
+
+// Restarts: leaks that opened while the daemon was down found within the window of the
+// restart; healthy restarts that raised internal_leakage.
+void write_restart_table(fmt::ostream& f, const std::vector<RunResult>& results,
+                         double detect_within) {
+  const auto all = candidates();
+  bool any = false;
+  for (const auto& r : results) any = any || !std::isnan(r.spec.restart_at);
+  if (!any) return;
+  f.print(
+      "\nRestarts (design thresholds; the leak opened while the daemon was down):\n\n"
+      "| detector | leak found within {:.0f} s of the restart (95 % CI) | oil warmer / cooler | "
+      "median delay | healthy restarts raising internal_leakage (95 % CI) | healthy h after "
+      "restarts | raised before the stop | state resumed |\n"
+      "|---|---|---|---|---|---|---|---|\n",
+      detect_within);
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    const RestartScore score = score_restarts(results, c, detect_within);
+    f.print("| {} | {} | {}/{} / {}/{} | {} | {} | {:.1f} | {} | {}/{} |\n", all[c].label,
+            percent_interval(score.found, score.leak_runs), score.found_warmer,
+            score.leak_runs_warmer, score.found_cooler, score.leak_runs_cooler,
+            median_text(score.delays, " s"),
+            percent_interval(score.healthy_raised, score.healthy_runs), score.healthy_hours_after,
+            score.raised_before_stop, score.restored, score.leak_runs + score.healthy_runs);
+  }
+}
 
 }  // namespace
 
@@ -42,9 +128,32 @@ void write_runs_json(const std::filesystem::path& path, const std::vector<RunRes
       }
       f.print("]");
     }
+    f.print("}}");
+    if (!r.spec.fault_channel.empty()) {
+      f.print(
+          ", \"fault\": {{\"channel\": \"{}\", \"kind\": \"{}\", \"variant\": \"{}\", "
+          "\"start\": {}, \"duration\": {}, \"seen\": {}}}",
+          r.spec.fault_channel, r.spec.fault_kind, r.spec.fault_variant,
+          json_number(r.spec.fault_start), json_number(r.spec.fault_end - r.spec.fault_start),
+          json_number(r.spec.fault_seen));
+    }
+    f.print(", \"sensor_fault_alarms\": [");
+    for (std::size_t a = 0; a < r.sensor_alarms.size(); ++a) {
+      const auto& alarm = r.sensor_alarms[a];
+      f.print("{}{{\"t\": {}, \"channel\": \"{}\", \"kind\": \"{}\"}}", a ? ", " : "",
+              json_number(alarm.t), alarm.channel, alarm.fault);
+    }
+    f.print("]");
+    if (!std::isnan(r.spec.restart_at)) {
+      f.print(
+          ", \"restart\": {{\"stop\": {}, \"downtime\": {}, \"restart\": {}, "
+          "\"temp_before\": {}, \"temp_after\": {}, \"states_restored\": {}}}",
+          json_number(r.spec.stop_at), json_number(r.spec.downtime), json_number(r.spec.restart_at),
+          json_number(r.spec.temp_before), json_number(r.spec.temp_after), r.states_restored);
+    }
     const SizeCheck& size = r.size_check;
     f.print(
-        "}}, \"size_at_raise\": {{\"t\": {}, \"leak_coefficient\": {}, "
+        ", \"size_at_raise\": {{\"t\": {}, \"leak_coefficient\": {}, "
         "\"half_width_95\": {}}}}}{}\n",
         json_number(size.t), json_number(size.leak_coefficient), json_number(size.half_width),
         i + 1 < results.size() ? "," : "");
@@ -186,27 +295,8 @@ void write_condition_summaries(const std::filesystem::path& dir, const Evaluatio
       f_md.print("\n");
     }
   }
-  // Sensor faults: named on the right channel within 5 s of the fault's start.
-  int faults = 0, named = 0, wrong_channel = 0;
-  for (const auto& r : results) {
-    if (r.spec.fault_channel.empty()) continue;
-    ++faults;
-    bool found = false;
-    for (const auto& a : r.sensor_alarms) {
-      if (a.t < r.spec.fault_start || a.t > r.spec.fault_end + 5.0) continue;
-      if (a.channel == r.spec.fault_channel && a.t <= r.spec.fault_start + 5.0) found = true;
-      if (a.channel != r.spec.fault_channel) ++wrong_channel;
-    }
-    named += found ? 1 : 0;
-  }
-  if (faults > 0) {
-    const Interval ci = clopper_pearson_95(named, faults);
-    f_md.print(
-        "\nSensor faults: {}/{} named on the faulty channel within 5 s (95 % interval "
-        "{:.0f}-{:.0f} "
-        "%); {} sensor_fault alarms on another channel while a fault was present.\n",
-        named, faults, 100.0 * ci.lower, 100.0 * ci.upper, wrong_channel);
-  }
+  write_sensor_fault_table(f_md, results, options.detect_within);
+  write_restart_table(f_md, results, options.detect_within);
 }
 
 }  // namespace leakmon::study

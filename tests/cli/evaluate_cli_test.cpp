@@ -116,6 +116,9 @@ TEST(EvaluateCommandOptions, RejectsBadOptions) {
   EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --jobs 0", dir), 2);
   EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --leaks 1e-12,abc", dir), 2);
   EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --keep-captures one", dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --sensor-fault-runs -1", dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --after-restart 0", dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --out " + dir + " --conditions restart,nap", dir), 2);
   EXPECT_EQ(run_leakmon("evaluate", dir), 2);  // --out is required
 }
 

@@ -116,7 +116,7 @@ TEST(SensorPlausibility, NoFaultOnLongHealthyRunsOfBothControllers) {
       EXPECT_EQ(trace.faulty_samples[c], 0) << preset << " " << kChannels[c];
       faulty += trace.faulty_samples[c];
       spikes += trace.spikes[c];
-      EXPECT_LE(trace.spikes[c], 2u) << preset << " " << kChannels[c] << ": healthy samples taken "
+      EXPECT_EQ(trace.spikes[c], 0u) << preset << " " << kChannels[c] << ": healthy samples taken "
                                      << "for spikes";
     }
   }
@@ -164,14 +164,13 @@ std::vector<Corruption> corruptions() {
                   [](std::vector<double>& v, std::size_t k) {
                     for (std::size_t i = k; i < v.size(); ++i) v[i] = 20.7e6;
                   }});
-  // 3 a minute, +-2 MPa: the fault is recognisable at the second spike (20 s after the first).
-  list.push_back({"p1 spikes 3/min", "p1", SensorFault::spikes,
-                  [](std::vector<double>& v, std::size_t k) {
-                    for (std::size_t i = k, n = 0; i < v.size(); i += 10'000, ++n) {
-                      v[i] += n % 2 == 0 ? 2e6 : -2e6;
-                    }
-                  },
-                  20.0});
+  // 3 a minute, +-2 MPa: named from the first spike.
+  list.push_back(
+      {"p1 spikes 3/min", "p1", SensorFault::spikes, [](std::vector<double>& v, std::size_t k) {
+         for (std::size_t i = k, n = 0; i < v.size(); i += 10'000, ++n) {
+           v[i] += n % 2 == 0 ? 2e6 : -2e6;
+         }
+       }});
   list.push_back({"p2 dropout to zeros", "p2", SensorFault::dropout,
                   [](std::vector<double>& v, std::size_t k) {
                     for (std::size_t i = k; i < v.size(); ++i) v[i] = 0.0;
@@ -223,26 +222,45 @@ TEST(SensorPlausibility, EachFaultNamedOnItsChannelWithinFiveSeconds) {
   }
 }
 
-TEST(SensorPlausibility, SingleSpikesAreReplacedWithoutAFault) {
-  capture::Capture capture = healthy("healthy", 41, 120.0);
+TEST(SensorPlausibility, OneSpikeIsNamedAndReplacedWithoutSuspendingTheStream) {
+  capture::Capture capture = healthy("healthy", 41, 150.0);
   const capture::Capture clean = capture;
   auto& p1 = capture.column("p1");
-  // One spike every 70 s: isolated, never two within a minute.
-  const std::vector<std::size_t> at = {10'000, 45'000};
+  // Two spikes 66 s apart: each is named at once and the fault clears after a quiet minute.
+  const std::vector<std::size_t> at = {5'000, 38'000};
   for (std::size_t i : at) p1[i] += 3e6;
-  const Trace trace = run(capture);
-  EXPECT_EQ(trace.faulty_samples[0], 0);
-  EXPECT_EQ(trace.spikes[0], at.size());
-  const auto& cleaned = trace.cleaned[0];
+  SensorPlausibility check(TransducerSpec::pressure(), kRate);
+  const std::size_t quiet = check.limits().spike_quiet, recovery = check.limits().recovery;
+  std::vector<double> cleaned;
+  std::vector<std::size_t> raised, cleared;
+  SensorFault before = SensorFault::none;
+  for (std::size_t i = 0; i < p1.size(); ++i) {
+    cleaned.push_back(check.push(p1[i]));
+    EXPECT_FALSE(check.suspect()) << i;
+    if (check.fault() != before) {
+      (check.fault() == SensorFault::spikes ? raised : cleared).push_back(i);
+      before = check.fault();
+    }
+  }
+  EXPECT_EQ(check.spikes_rejected(), at.size());
+  ASSERT_EQ(raised.size(), at.size());
+  ASSERT_EQ(cleared.size(), at.size());
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    // Named when the spike leaves the filter, kDelay samples after it arrived.
+    EXPECT_EQ(raised[k], at[k] + SensorPlausibility::kDelay);
+    // Quiet for spike_quiet samples, then recovery samples of maintenance_required.
+    EXPECT_NEAR(static_cast<double>(cleared[k]), static_cast<double>(at[k] + quiet + recovery),
+                5.0);
+  }
   const auto& truth = clean.column("p1");
   for (std::size_t i : at) {
     // The replacement is the neighbours' median: within a few noise sigmas of the real sample.
-    EXPECT_NEAR(cleaned[i], truth[i], 50e3) << i;
+    EXPECT_NEAR(cleaned[i + SensorPlausibility::kDelay], truth[i], 50e3) << i;
   }
   // Everything else passes unchanged.
   std::size_t changed = 0;
   for (std::size_t i = 0; i + SensorPlausibility::kDelay < cleaned.size(); ++i) {
-    if (cleaned[i] != truth[i]) ++changed;
+    if (cleaned[i + SensorPlausibility::kDelay] != truth[i]) ++changed;
   }
   EXPECT_EQ(changed, at.size());
 }
@@ -278,6 +296,34 @@ TEST(SensorPlausibility, RecoversThroughMaintenanceRequiredToOk) {
   EXPECT_EQ(check.fault(), SensorFault::none);
 }
 
+// A minute at full scale: once the reading is back the stream is trusted again within a fraction
+// of a second and the channel is ok after the 2 s recovery, not a quarter of the fault later.
+TEST(SensorPlausibility, RecoversPromptlyAfterALongSaturation) {
+  capture::Capture capture = healthy("healthy", 52, 100.0);
+  auto& p1 = capture.column("p1");
+  const std::size_t from = 10'000, to = 40'000;  // saturated 20 s .. 80 s
+  for (std::size_t i = from; i < to; ++i) p1[i] = 4095.0 * lsb();
+  SensorPlausibility check(TransducerSpec::pressure(), kRate);
+  long trusted_at = -1, ok_at = -1;
+  for (std::size_t i = 0; i < p1.size(); ++i) {
+    check.push(p1[i]);
+    if (i == to - 1) {
+      EXPECT_EQ(check.fault(), SensorFault::saturated);
+    }
+    if (i >= to && trusted_at < 0 && check.status() != io::DeviceStatus::failure &&
+        !check.suspect()) {
+      trusted_at = static_cast<long>(i);
+    }
+    if (i >= to && ok_at < 0 && check.status() == io::DeviceStatus::ok) {
+      ok_at = static_cast<long>(i);
+    }
+  }
+  ASSERT_GE(ok_at, 0);
+  ASSERT_GE(trusted_at, 0);
+  EXPECT_LE(static_cast<double>(ok_at - static_cast<long>(to)) / kRate, 2.5);
+  EXPECT_LE(static_cast<double>(trusted_at - static_cast<long>(to)) / kRate, 2.5);
+}
+
 TEST(SensorPlausibility, PushAllocatesNothing) {
   const capture::Capture capture = healthy("healthy", 61, 10.0);
   auto p1 = capture.column("p1");
@@ -296,7 +342,7 @@ TEST(SensorPlausibility, PushAllocatesNothing) {
 
 // Random draws (fresh seed each run, printed): rig seed, controller, channel, fault kind, onset
 // and spike sizes and places. The target is >= 95 % of faults named within 5 s of becoming
-// recognisable (spikes: of the second spike). Measured: 794 of 800 draws named (two runs of
+// recognisable (spikes: of the first spike). Measured: 794 of 800 draws named (two runs of
 // 400), all six misses spikes on x under the fault-tolerant controller (its fast moves widen the
 // Hampel threshold). At a 0.75 % miss rate, more than 4 misses in 80 draws happen about once in
 // 2500 runs.
@@ -340,15 +386,15 @@ TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
       case SensorFault::spikes: {
         // 3 a minute at uniformly random places, +-1..4 MPa (x: +-2..8 mm).
         std::uniform_real_distribution<double> size(1.0, 4.0);
-        std::size_t second = 0;
+        std::size_t first = 0;
         for (std::size_t i = onset, n = 0; i < v.size(); ++n) {
           const double sign = random() % 2 == 0 ? 1.0 : -1.0;
           v[i] += sign * size(random) * (pressure ? 1e6 : 2e-3);
-          if (n == 1) second = i;
+          if (n == 0) first = i;
           i += static_cast<std::size_t>(std::uniform_real_distribution<double>(5.0, 35.0)(random) *
                                         kRate);
         }
-        recognisable_s = static_cast<double>(second) / kRate;
+        recognisable_s = static_cast<double>(first) / kRate;
         break;
       }
       case SensorFault::none:
