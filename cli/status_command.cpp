@@ -1,28 +1,39 @@
 // `leakmon status` and `leakmon ack`: talk to a running daemon over its metrics endpoint.
 #include <fmt/format.h>
 
+#include <filesystem>
+
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/http_endpoint.hpp"
+#include "daemon/status_json.hpp"
 
 namespace leakmon::cli {
 namespace {
 
+constexpr const char* kDefaultConfig = "/etc/leakmon/leakmon.yaml";
+
 void endpoint_options(ArgParser& args) {
-  args.option("config", "CONFIG.yaml", "take address and port from the daemon's configuration",
-              std::string("/etc/leakmon/leakmon.yaml"));
+  args.option("config", "CONFIG.yaml",
+              "take address and port from the daemon's configuration (when it exists, the "
+              "default's does not have to: then the built-in 127.0.0.1:9187)",
+              std::string(kDefaultConfig));
   args.option("port", "N", "metrics port (overrides --config)", std::string(""));
   args.option("address", "IP", "metrics address", std::string(""));
 }
 
 std::pair<std::string, int> endpoint(const ArgParser& args) {
-  daemon::MetricsConfig metrics;
+  daemon::MetricsConfig metrics;  // the daemon's own defaults
+  const std::string config = args.get("config");
   if (args.get("port").empty()) {
-    metrics = daemon::load_config(args.get("config")).metrics;
-    if (metrics.port == 0) {
-      throw UsageError(
-          fmt::format("{} disables the metrics endpoint (metrics.port: 0)", args.get("config")));
+    // A configuration named on the command line must exist; the default one may be absent (a
+    // daemon run with --config elsewhere, or on the defaults): then the built-in port applies.
+    if (config != kDefaultConfig || std::filesystem::exists(config)) {
+      metrics = daemon::load_config(config).metrics;
+      if (metrics.port == 0) {
+        throw UsageError(fmt::format("{} disables the metrics endpoint (metrics.port: 0)", config));
+      }
     }
   } else {
     metrics.port = static_cast<int>(args.get_int("port"));
@@ -36,11 +47,16 @@ std::pair<std::string, int> endpoint(const ArgParser& args) {
 int run_status(int argc, char** argv) {
   ArgParser args("status", "print a summary from the running daemon");
   endpoint_options(args);
+  args.flag("json", "print the daemon's JSON status as it is");
   if (!args.parse(argc, argv)) return 0;
   const auto [address, port] = endpoint(args);
   const auto response = daemon::http_request(address, port, "GET", "/status");
-  fmt::print("{}", response.body);
-  return response.status == 200 ? 0 : 1;
+  if (response.status != 200 || args.flag_set("json")) {
+    fmt::print("{}", response.body);
+    return response.status == 200 ? 0 : 1;
+  }
+  fmt::print("{}", daemon::status_text_from_json(response.body));
+  return 0;
 }
 
 int run_ack(int argc, char** argv) {
@@ -49,8 +65,10 @@ int run_ack(int argc, char** argv) {
   args.option("actuator", "NAME", "only this actuator's alarm (default: all)", std::string(""));
   if (!args.parse(argc, argv)) return 0;
   const auto [address, port] = endpoint(args);
-  const auto response =
-      daemon::http_request(address, port, "POST", "/ack?actuator=" + args.get("actuator"));
+  const std::string actuator = args.get("actuator");
+  const auto response = daemon::http_request(
+      address, port, "POST",
+      actuator.empty() ? std::string("/ack") : "/ack?actuator=" + daemon::percent_encode(actuator));
   fmt::print("{}", response.body);
   return response.status == 200 ? 0 : 1;
 }

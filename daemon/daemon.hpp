@@ -39,7 +39,9 @@ class Daemon {
 
   // Prometheus text exposition of everything the daemon counts (daemon/metrics_text.cpp).
   std::string metrics_text() const;
-  // The human summary `leakmon status` prints (daemon/metrics_text.cpp).
+  // GET /status: the status as JSON, and the human summary made from it that `leakmon status`
+  // prints (daemon/status_json.cpp).
+  std::string status_json() const;
   std::string status_text() const;
 
  private:
@@ -70,6 +72,9 @@ class Daemon {
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   HttpResponse handle(const HttpRequest& request);
+  HttpResponse acknowledge(const HttpRequest& request);
+  HttpResponse status(const HttpRequest& request) const;
+  HttpResponse metrics_response() const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -78,6 +83,7 @@ class Daemon {
   std::vector<std::unique_ptr<io::EventSink>> sinks_;
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
+  HttpCounters http_counters_;  // before endpoint_: the endpoint counts into it
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;
