@@ -193,10 +193,11 @@ void HttpEndpoint::watch_deadlines() {
     for (Connection* connection : connections_) {
       if (connection->closing || connection->fd < 0) continue;
       if (now - connection->request_start_ns <= deadline_ns) continue;
-      // The event loop sees the hang-up and closes the connection itself.
-      ::shutdown(connection->fd, SHUT_RDWR);
-      connection->closing = true;
+      // Counted first, so whoever sees the connection end also sees the count. The event loop
+      // sees the hang-up and closes the connection itself.
       counters_->deadline_closes.fetch_add(1, std::memory_order_relaxed);
+      connection->closing = true;
+      ::shutdown(connection->fd, SHUT_RDWR);
     }
   }
 }

@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -156,8 +157,34 @@ TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
   EXPECT_EQ(ack.status, 200) << ack.body;
   EXPECT_EQ(alarm_state(port), "active_acknowledged");
 
+  // `leakmon status` prints the human form from the JSON: states, never nan.
+  test::DaemonProcess cli({"status", "--port", std::to_string(port)}, dir + "/cli.log");
+  EXPECT_EQ(cli.wait(30s), 0) << cli.log();
+  EXPECT_NE(cli.log().find("actuator cylinder: ALARM"), std::string::npos) << cli.log();
+  EXPECT_NE(cli.log().find("alarm internal_leakage: active_acknowledged"), std::string::npos)
+      << cli.log();
+  EXPECT_EQ(cli.log().find("nan"), std::string::npos) << cli.log();
+
   daemon.signal(SIGTERM);
   EXPECT_EQ(daemon.wait(30s), 0) << daemon.log();
+}
+
+// Without options, `leakmon status` looks for /etc/leakmon/leakmon.yaml; when that does not exist
+// it asks the built-in default address instead of failing on the missing file.
+TEST(HttpProcess, StatusWithoutOptionsNeedsNoConfigurationFile) {
+  if (std::filesystem::exists("/etc/leakmon/leakmon.yaml")) {
+    GTEST_SKIP() << "/etc/leakmon/leakmon.yaml exists here: the default path is then used";
+  }
+  const std::string dir = test::scratch_dir("http_process_status");
+  test::DaemonProcess status({"status"}, dir + "/status.log");
+  status.wait(30s);
+  EXPECT_EQ(status.log().find("leakmon.yaml"), std::string::npos) << status.log();
+  // Either a daemon on the default port answered, or the message names that address.
+  const bool answered = status.log().find("actuator ") != std::string::npos;
+  EXPECT_TRUE(answered || status.log().find("127.0.0.1:9187") != std::string::npos) << status.log();
+  test::DaemonProcess missing({"status", "--config", dir + "/absent.yaml"}, dir + "/missing.log");
+  EXPECT_NE(missing.wait(30s), 0);
+  EXPECT_NE(missing.log().find("absent.yaml"), std::string::npos) << missing.log();
 }
 
 }  // namespace

@@ -17,8 +17,8 @@ static int metrics(mg_connection* c, void*) {
 
 int main(int, char** argv) {
   const std::string port = std::string("127.0.0.1:") + argv[1];
-  const char* options[] = {"listening_ports", port.c_str(), "num_threads", "8",
-                           "request_timeout_ms", "2000", nullptr};
+  const char* options[] = {"listening_ports",    port.c_str(), "num_threads", "8",
+                           "request_timeout_ms", "2000",       nullptr};
   mg_init_library(0);
   mg_context* ctx = mg_start(nullptr, nullptr, options);
   mg_set_request_handler(ctx, "/metrics", metrics, nullptr);

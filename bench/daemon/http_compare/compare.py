@@ -20,7 +20,7 @@ OUT = sys.argv[1] if len(sys.argv) > 1 else "/tmp/http_compare"
 SERVERS = {
     "libmicrohttpd 0.9.75": ("microhttpd_server.cpp", ["-lmicrohttpd"]),
     "civetweb 1.15": ("civetweb_server.cpp", ["-lcivetweb"]),
-    "cpp-httplib 0.11.4": ("httplib_server.cpp", ["-lpthread"]),
+    "cpp-httplib 0.11.4": ("httplib_server.cpp", ["-lcpp-httplib", "-lpthread"]),
 }
 
 

@@ -12,7 +12,8 @@ static std::string body(9000, 'm');
 
 static MHD_Result answer(void*, MHD_Connection* c, const char*, const char*, const char*,
                          const char*, size_t*, void**) {
-  MHD_Response* r = MHD_create_response_from_buffer(body.size(), body.data(), MHD_RESPMEM_PERSISTENT);
+  MHD_Response* r =
+      MHD_create_response_from_buffer(body.size(), body.data(), MHD_RESPMEM_PERSISTENT);
   const MHD_Result result = MHD_queue_response(c, 200, r);
   MHD_destroy_response(r);
   return result;
