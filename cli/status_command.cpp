@@ -1,20 +1,25 @@
 // `leakmon status` and `leakmon ack`: talk to a running daemon over its metrics endpoint.
 #include <fmt/format.h>
 
-#include <cctype>
-#include <string_view>
+#include <filesystem>
 
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/http_endpoint.hpp"
+#include "daemon/status_json.hpp"
 
 namespace leakmon::cli {
 namespace {
 
+constexpr const char* kDefaultConfig = "/etc/leakmon/leakmon.yaml";
+
 void endpoint_options(ArgParser& args) {
-  args.option("config", "CONFIG.yaml", "take address and port from the daemon's configuration",
-              std::string("/etc/leakmon/leakmon.yaml"));
+  args.option("config", "CONFIG.yaml",
+              "take address, port and acknowledgement token from the daemon's configuration "
+              "(when it exists, the default's does not have to: then the built-in "
+              "127.0.0.1:9187)",
+              std::string(kDefaultConfig));
   args.option("port", "N", "metrics port (overrides --config)", std::string(""));
   args.option("address", "IP", "metrics address", std::string(""));
   args.option("token", "TOKEN", "acknowledgement token (default: metrics.ack_token of --config)",
@@ -23,12 +28,16 @@ void endpoint_options(ArgParser& args) {
 
 // Address, port and the acknowledgement token (metrics.ack_token) of the daemon's endpoint.
 daemon::MetricsConfig endpoint(const ArgParser& args) {
-  daemon::MetricsConfig metrics;
+  daemon::MetricsConfig metrics;  // the daemon's own defaults
+  const std::string config = args.get("config");
   if (args.get("port").empty()) {
-    metrics = daemon::load_config(args.get("config")).metrics;
-    if (metrics.port == 0) {
-      throw UsageError(
-          fmt::format("{} disables the metrics endpoint (metrics.port: 0)", args.get("config")));
+    // A configuration named on the command line must exist; the default one may be absent (a
+    // daemon run with --config elsewhere, or on the defaults): then the built-in port applies.
+    if (config != kDefaultConfig || std::filesystem::exists(config)) {
+      metrics = daemon::load_config(config).metrics;
+      if (metrics.port == 0) {
+        throw UsageError(fmt::format("{} disables the metrics endpoint (metrics.port: 0)", config));
+      }
     }
   } else {
     metrics.port = static_cast<int>(args.get_int("port"));
@@ -38,30 +47,21 @@ daemon::MetricsConfig endpoint(const ArgParser& args) {
   return metrics;
 }
 
-// %XX for everything but unreserved characters, so names and tokens survive the query string.
-std::string url_encoded(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (std::isalnum(u) || c == '-' || c == '_' || c == '.' || c == '~') {
-      out += c;
-    } else {
-      out += fmt::format("%{:02X}", static_cast<unsigned>(u));
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 int run_status(int argc, char** argv) {
   ArgParser args("status", "print a summary from the running daemon");
   endpoint_options(args);
+  args.flag("json", "print the daemon's JSON status as it is");
   if (!args.parse(argc, argv)) return 0;
   const auto metrics = endpoint(args);
   const auto response = daemon::http_request(metrics.address, metrics.port, "GET", "/status");
-  fmt::print("{}", response.body);
-  return response.status == 200 ? 0 : 1;
+  if (response.status != 200 || args.flag_set("json")) {
+    fmt::print("{}", response.body);
+    return response.status == 200 ? 0 : 1;
+  }
+  fmt::print("{}", daemon::status_text_from_json(response.body));
+  return 0;
 }
 
 int run_ack(int argc, char** argv) {
@@ -70,9 +70,14 @@ int run_ack(int argc, char** argv) {
   args.option("actuator", "NAME", "only this actuator's alarm (default: all)", std::string(""));
   if (!args.parse(argc, argv)) return 0;
   const auto metrics = endpoint(args);
-  std::string target = "/ack?actuator=" + url_encoded(args.get("actuator"));
-  if (!metrics.ack_token.empty()) target += "&token=" + url_encoded(metrics.ack_token);
-  const auto response = daemon::http_request(metrics.address, metrics.port, "POST", target);
+  const std::string actuator = args.get("actuator");
+  std::string query;
+  if (!actuator.empty()) query = "actuator=" + daemon::percent_encode(actuator);
+  if (!metrics.ack_token.empty()) {
+    query += (query.empty() ? "" : "&") + ("token=" + daemon::percent_encode(metrics.ack_token));
+  }
+  const auto response = daemon::http_request(metrics.address, metrics.port, "POST",
+                                             query.empty() ? "/ack" : "/ack?" + query);
   fmt::print("{}", response.body);
   return response.status == 200 ? 0 : 1;
 }

@@ -336,6 +336,10 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.detector = detector_->name();
   status.state = alarm_.state();
   status.learning = last_decision_.learning;
+  status.learning_seconds_left = last_decision_.learning_hops_left *
+                                 static_cast<double>(config_.features.step) / sample_rate_hz_;
+  status.raise_threshold = alarm_.settings().raise_threshold;
+  status.clear_threshold = alarm_.settings().clear_threshold;
   status.t = last_t_;
   const auto latest = features_.latest();
   status.index_p1 = latest.empty() ? kNaN : latest[0].rms;

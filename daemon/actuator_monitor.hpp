@@ -48,6 +48,9 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
+  double learning_seconds_left = io::kNoValue;  // while learning, when the detector knows
+  double raise_threshold = io::kNoValue;        // the score at which the alarm raises
+  double clear_threshold = io::kNoValue;
   double t = io::kNoValue;         // source time of the newest decision
   double index_p1 = io::kNoValue;  // Pa
   double index_p2 = io::kNoValue;

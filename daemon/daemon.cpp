@@ -13,6 +13,7 @@
 
 #include "daemon/driver_registry.hpp"
 #include "daemon/event_log.hpp"
+#include "daemon/http_router.hpp"
 #include "daemon/output_registry.hpp"
 
 namespace leakmon::daemon {
@@ -223,7 +224,8 @@ void Daemon::start() {
   if (config_.metrics.port != 0) {
     endpoint_ = std::make_unique<HttpEndpoint>(
         config_.metrics.address, config_.metrics.port,
-        [this](const HttpRequest& request) { return handle(request); });
+        [this](const HttpRequest& request) { return handle(request); }, HttpLimits{},
+        &http_counters_);
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
     operator_view_->start_sampling([this](ViewSnapshot& out) { fill_view_snapshot(out); });
@@ -452,20 +454,41 @@ int Daemon::run(double duration_s) {
   return 0;
 }
 
+// One route per line: the path, its method, and what serves it (daemon/http_router.hpp answers
+// 405 with Allow for another method on a known path, 404 for the rest).
 HttpResponse Daemon::handle(const HttpRequest& request) {
   if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
-  if (request.path == "/metrics" && request.method == "GET")
-    return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
-  if (request.path == "/status" && request.method == "GET")
-    return {200, "text/plain; charset=utf-8", status_text()};
-  if (request.path == "/ack") {
-    if (request.method != "POST") return {405, "text/plain", "use POST /ack?actuator=NAME\n"};
-    const std::string actuator = query_value(request.query, "actuator");
-    const std::size_t matched = worker_->acknowledge(actuator);
-    if (matched == 0) return {404, "text/plain", fmt::format("no actuator '{}'\n", actuator)};
-    return {200, "text/plain", fmt::format("acknowledged {} actuator(s)\n", matched)};
+  const HttpRoute routes[] = {
+      {"/metrics", "GET", [this](const HttpRequest&) { return metrics_response(); }},
+      {"/status", "GET", [this](const HttpRequest& r) { return status(r); }},
+      {"/ack", "POST", [this](const HttpRequest& r) { return acknowledge(r); }},
+  };
+  return route(routes, request);
+}
+
+HttpResponse Daemon::metrics_response() const {
+  return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
+}
+
+HttpResponse Daemon::status(const HttpRequest& request) const {
+  const StatusFormat format = status_format(request);
+  if (format.error) return *format.error;
+  if (format.text) return {200, "text/plain; charset=utf-8", status_text()};
+  return {200, "application/json", status_json()};
+}
+
+// POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME. Anything else
+// acknowledges nothing (daemon/http_router.hpp ack_selection()).
+HttpResponse Daemon::acknowledge(const HttpRequest& request) {
+  const AckSelection selection = ack_selection(request);
+  if (selection.error) return *selection.error;
+  const std::size_t matched = worker_->acknowledge(selection.actuator);
+  if (matched == 0) {
+    return {404, "text/plain; charset=utf-8",
+            selection.actuator.empty() ? std::string("no actuators configured\n")
+                                       : fmt::format("no actuator '{}'\n", selection.actuator)};
   }
-  return {404, "text/plain", "try /, /metrics, /status or POST /ack\n"};
+  return {200, "text/plain; charset=utf-8", fmt::format("acknowledged {} actuator(s)\n", matched)};
 }
 
 }  // namespace leakmon::daemon

@@ -42,7 +42,9 @@ class Daemon {
 
   // Prometheus text exposition of everything the daemon counts (daemon/metrics_text.cpp).
   std::string metrics_text() const;
-  // The human summary `leakmon status` prints (daemon/metrics_text.cpp).
+  // GET /status: the status as JSON, and the human summary made from it that `leakmon status`
+  // prints (daemon/status_json.cpp).
+  std::string status_json() const;
   std::string status_text() const;
 
  private:
@@ -80,6 +82,9 @@ class Daemon {
   HttpResponse handle(const HttpRequest& request);
   // The live page's sample of the status (daemon/operator_view.cpp).
   void fill_view_snapshot(ViewSnapshot& out) const;
+  HttpResponse acknowledge(const HttpRequest& request);
+  HttpResponse status(const HttpRequest& request) const;
+  HttpResponse metrics_response() const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -90,6 +95,7 @@ class Daemon {
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<OperatorView> operator_view_;  // the live page; null without an endpoint
+  HttpCounters http_counters_;  // before endpoint_: the endpoint counts into it
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;

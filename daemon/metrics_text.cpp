@@ -312,48 +312,17 @@ std::string Daemon::metrics_text() const {
       out.family(name, metric.help, metric.counter ? "counter" : "gauge");
     out.sample(name, label("output", output), metric.value);
   }
+  out.family("leakmon_http_requests_total", "HTTP requests whose head was read", "counter");
+  out.sample("leakmon_http_requests_total", "", http_counters_.requests.load());
+  out.family("leakmon_http_rejected_total",
+             "HTTP requests refused before routing (400 target, 413 body, 431 headers)", "counter");
+  out.sample("leakmon_http_rejected_total", "", http_counters_.rejected.load());
+  out.family("leakmon_http_deadline_closes_total",
+             "HTTP connections closed because their request outlived the deadline", "counter");
+  out.sample("leakmon_http_deadline_closes_total", "", http_counters_.deadline_closes.load());
+  out.family("leakmon_http_connections", "open HTTP connections", "gauge");
+  out.sample("leakmon_http_connections", "", http_counters_.open_connections.load());
   return out.take();
-}
-
-std::string Daemon::status_text() const {
-  std::string out =
-      fmt::format("leakmon {} running {:.0f} s, configuration {}\n", LEAKMON_VERSION,
-                  static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9, config_path_);
-  out += fmt::format("last reload: {}\n", last_reload_ok_.load() ? "ok" : "REJECTED (see log)");
-  for (const auto& g : groups_) {
-    const auto& c = g->loop->counters();
-    out += fmt::format(
-        "group {}: {} cycles, wake-up latency avg {:.1f} us max {:.1f} us, {} overruns, {} missed, "
-        "{} ring drops (high water {}/{}), {}\n",
-        g->config.name, c.cycles.load(), c.wakeup_latency.mean_ns() / 1e3,
-        static_cast<double>(c.wakeup_latency.max_ns()) / 1e3, c.overruns.load(),
-        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(), g->ring->capacity(),
-        g->realtime.fifo ? "SCHED_FIFO" : "normal scheduling");
-  }
-  for (const auto& d : drivers_) {
-    const auto health = d->health();
-    out += fmt::format("driver {}: {} (NE 107 {}){}{} ({} errors)\n", d->name(), health.detail,
-                       io::to_string(health.status), health.last_error.empty() ? "" : ": ",
-                       health.last_error, health.errors);
-  }
-  for (const auto& a : worker_->status()) {
-    out += fmt::format(
-        "actuator {}: alarm {} {}, index p1 {:.2f} kPa, score {:.3g}, baseline {:.2f} "
-        "kPa{}, detector {}, t {:.2f} s\n",
-        a.name, a.alarm, to_string(a.state), a.index_p1 / 1e3, a.score, a.baseline / 1e3,
-        a.learning ? " (learning)" : "", a.detector, a.t);
-    if (std::isfinite(a.oil_temperature)) {
-      out += fmt::format("  oil temperature {:.1f} degC\n", a.oil_temperature);
-    }
-    for (const auto& c : a.channels) {
-      out += fmt::format("  channel {}: {}{}{}, {} spikes rejected\n", c.channel,
-                         io::to_string(c.status), c.fault == detect::SensorFault::none ? "" : " ",
-                         c.fault == detect::SensorFault::none ? "" : detect::to_string(c.fault),
-                         c.spikes_rejected);
-    }
-    if (a.suspended) out += "  leak decision suspended (sensor fault)\n";
-  }
-  return out;
 }
 
 }  // namespace leakmon::daemon

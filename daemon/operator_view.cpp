@@ -393,14 +393,19 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
       std::lock_guard lock(mutex_);
       token = ack_token_;
     }
-    if (token.empty() || same_token(query_value(request.query, "token"), token)) {
+    // The token as a query parameter (the page, `leakmon ack`) or as a bearer credential.
+    constexpr std::string_view kBearer = "Bearer ";
+    const std::string_view authorization = request.authorization;
+    const bool bearer_ok = authorization.substr(0, kBearer.size()) == kBearer &&
+                           same_token(authorization.substr(kBearer.size()), token);
+    if (token.empty() || bearer_ok || same_token(query_value(request.query, "token"), token)) {
       return std::nullopt;  // the daemon acknowledges
     }
     return HttpResponse{401, "text/plain; charset=utf-8",
                         "acknowledging needs the token of metrics.ack_token: POST "
                         "/ack?actuator=NAME&token=TOKEN\n"};
   }
-  if (request.method != "GET") return std::nullopt;
+  if (request.method != "GET" && request.method != "HEAD") return std::nullopt;
   if (request.path == "/api/trend") {
     const std::string since = query_value(request.query, "since");
     char* end = nullptr;
@@ -426,7 +431,14 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
       request.path == "/index.html" ? std::string_view("/") : std::string_view(request.path);
   for (const auto& asset : web_assets()) {
     if (asset.path == path) {
-      return HttpResponse{200, std::string(asset.content_type), std::string(asset.body)};
+      // The page's policy as a header too: the meta tag cannot forbid framing.
+      return HttpResponse{200,
+                          std::string(asset.content_type),
+                          std::string(asset.body),
+                          {{"Content-Security-Policy",
+                            "default-src 'none'; script-src 'self'; style-src 'self'; "
+                            "img-src 'self'; connect-src 'self'; frame-ancestors 'none'"},
+                           {"X-Content-Type-Options", "nosniff"}}};
     }
   }
   return std::nullopt;

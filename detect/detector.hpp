@@ -38,7 +38,10 @@ struct Decision {
   // clears when score <= clear_threshold(). NaN when the detector cannot judge this hop (still
   // learning, or the observation had gaps): the alarm state then holds.
   double score = kMissing;
-  bool learning = true;        // still learning the healthy baseline
+  bool learning = true;  // still learning the healthy baseline
+  // While learning: the hops until the baseline is learned (settling included), for operators
+  // ("learning, 23 s left"); NaN when not learning or not known.
+  double learning_hops_left = kMissing;
   double baseline = kMissing;  // learned healthy level of the index [Pa]
   double index = kMissing;     // the index value this decision used [Pa]
   // Estimated internal leakage coefficient C_L [m^3/(s Pa)] and its 95 % half-width; NaN when

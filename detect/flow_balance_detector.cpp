@@ -323,6 +323,10 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
   const double ps = options_.rig.ps;  // the scale of the slope (see update())
   Decision decision;
   ++hops_seen_;
+  if (!learned_model_) {
+    const std::size_t total = settle_hops_ + learn_hops_;
+    decision.learning_hops_left = static_cast<double>(hops_seen_ >= total ? 0 : total - hops_seen_);
+  }
   if (hops_seen_ <= settle_hops_) {
     last_ = decision;
     return;

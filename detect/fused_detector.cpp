@@ -22,6 +22,9 @@ Decision FusedDetector::update(const Observation& observation) {
     const Decision d = members_[i]->update(observation);
     member_decisions_[i] = d;
     fused.learning = fused.learning || d.learning;
+    if (d.learning && !(d.learning_hops_left <= fused.learning_hops_left)) {
+      fused.learning_hops_left = d.learning_hops_left;  // the slowest member decides
+    }
     if (!std::isnan(d.score)) {
       const double relative = d.score / members_[i]->raise_threshold();
       if (std::isnan(fused.score) || relative > fused.score) fused.score = relative;

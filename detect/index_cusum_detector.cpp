@@ -302,6 +302,10 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   const double log_index = log_index_of(observation);
   decision.index = std::isnan(log_index) ? kMissing : std::exp(log_index);
   ++hops_seen_;
+  if (!learned_model_) {
+    const std::size_t total = settle_hops_ + learn_hops_;
+    decision.learning_hops_left = static_cast<double>(hops_seen_ >= total ? 0 : total - hops_seen_);
+  }
   if (hops_seen_ <= settle_hops_) return decision;
   if (!std::isnan(observation.temp)) temperature_seen_ = true;
 

@@ -31,6 +31,10 @@ Decision PaperBaselineDetector::update(const Observation& observation) {
   Decision decision;
   decision.index = index;
   ++hops_seen_;
+  if (std::isnan(baseline_)) {
+    const std::size_t total = settle_hops_ + learn_hops_;
+    decision.learning_hops_left = static_cast<double>(hops_seen_ >= total ? 0 : total - hops_seen_);
+  }
   if (hops_seen_ <= settle_hops_) return decision;
 
   if (std::isnan(baseline_)) {

@@ -88,8 +88,9 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   EXPECT_NE(
       metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"x\",status=\"failure\"} 0"),
       std::string::npos);
-  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/status").body.find("channel p2: ok"),
-            std::string::npos);
+  EXPECT_NE(
+      http_request("127.0.0.1", port, "GET", "/status?format=text").body.find("channel p2: ok"),
+      std::string::npos);
 
   // A valid change applies; a broken file is rejected with its location and changes nothing.
   const std::string events = dir + "/events.jsonl";
