@@ -351,8 +351,6 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.oil_temperature = last_temperature_;
   status.p1 = last_p1_;
   status.p2 = last_p2_;
-  status.raise_threshold = alarm_.settings().raise_threshold;
-  status.clear_threshold = alarm_.settings().clear_threshold;
   status.decisions = decisions_;
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;

@@ -62,8 +62,6 @@ struct ActuatorStatus {
   double oil_temperature = io::kNoValue;      // degC, newest hop mean of the `temp` channel
   double p1 = io::kNoValue;                   // Pa, chamber pressures: newest hop means
   double p2 = io::kNoValue;
-  double raise_threshold = io::kNoValue;  // the alarm's effective thresholds on the score
-  double clear_threshold = io::kNoValue;
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
   std::vector<ChannelHealth> channels;

@@ -29,12 +29,12 @@ struct MHD_Daemon;
 namespace leakmon::daemon {
 
 struct HttpRequest {
-  std::string method;              // "GET", "HEAD", "POST", ...
-  std::string path;                // decoded, without the query
-  std::string query;               // after '?', undecoded
-  std::vector<QueryParam> params;  // the query split at '&' and '=', decoded
-  std::string accept;              // the Accept header, empty when absent
-  std::string authorization;       // the Authorization header, empty when absent
+  std::string method;                   // "GET", "HEAD", "POST", ...
+  std::string path;                     // decoded, without the query
+  std::string query;                    // after '?', undecoded
+  std::vector<QueryParam> params = {};  // the query split at '&' and '=', decoded
+  std::string accept = {};              // the Accept header, empty when absent
+  std::string authorization = {};       // the Authorization header, empty when absent
 };
 
 struct HttpResponse {
