@@ -59,7 +59,8 @@ bool ArgParser::parse(int argc, char** argv, int first) {
       if (inline_value) {
         values_[spec->name] = *inline_value;
       } else {
-        if (i + 1 >= argc) throw UsageError(fmt::format("option '--{}' needs a value ({})", body, spec->meta));
+        if (i + 1 >= argc)
+          throw UsageError(fmt::format("option '--{}' needs a value ({})", body, spec->meta));
         values_[spec->name] = argv[++i];
       }
       continue;

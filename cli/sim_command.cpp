@@ -8,9 +8,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "config/yaml_reader.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
+#include "config/yaml_reader.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 

@@ -9,12 +9,12 @@
 #include <optional>
 #include <string>
 
+#include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/replay.hpp"
 #include "daemon/state_store.hpp"
-#include "capture/capture.hpp"
 
 namespace leakmon::cli {
 namespace {

@@ -95,7 +95,7 @@ class Daemon {
   std::unique_ptr<Worker> worker_;
   std::thread worker_thread_;
   std::unique_ptr<OperatorView> operator_view_;  // the live page; null without an endpoint
-  HttpCounters http_counters_;  // before endpoint_: the endpoint counts into it
+  HttpCounters http_counters_;                   // before endpoint_: the endpoint counts into it
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;

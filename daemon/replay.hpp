@@ -11,7 +11,6 @@
 #include "capture/capture.hpp"
 #include "daemon/actuator_monitor.hpp"
 #include "daemon/config.hpp"
-#include "capture/capture.hpp"
 #include "daemon/state_store.hpp"
 #include "io/event.hpp"
 

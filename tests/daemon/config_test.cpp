@@ -155,9 +155,9 @@ TEST(DaemonConfig, CheckConfigFindsMissingChannelsAndBadDriverTypes) {
 TEST(DaemonConfig, ShippedExamplesAreValid) {
   // Examples without `state:` use $STATE_DIRECTORY, which the pre-flight checks is writable.
   ::setenv("STATE_DIRECTORY", test::scratch_dir("config_examples_state").c_str(), 1);
-  for (const char* file : {"/config/demo.yaml", "/io/sim/sim.yaml",
-                           "/bench/daemon/rss_8_channels.yaml", "/io/replay/replay.yaml",
-                           "/io/mqtt/mqtt.yaml"}) {
+  for (const char* file :
+       {"/config/demo.yaml", "/io/sim/sim.yaml", "/bench/daemon/rss_8_channels.yaml",
+        "/io/replay/replay.yaml", "/io/mqtt/mqtt.yaml"}) {
     // The file itself and its paths; the port may be taken by a concurrent test.
     EXPECT_NO_THROW(check_config(test::source_dir() + file, Preflight{true, false})) << file;
   }

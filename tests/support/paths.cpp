@@ -11,7 +11,8 @@ std::string leakmon_binary() { return binary_dir() + "/bin/leakmon"; }
 
 std::string shared_data_dir() {
   if (const char* env = std::getenv("LEAKMON_SHARED_DATA")) return env;
-  return std::filesystem::weakly_canonical(std::filesystem::path(source_dir()) / ".." / "shared" / "data")
+  return std::filesystem::weakly_canonical(std::filesystem::path(source_dir()) / ".." / "shared" /
+                                           "data")
       .string();
 }
 
