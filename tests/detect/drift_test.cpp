@@ -18,16 +18,6 @@ constexpr double kHop = 0.04;
 // from its coldest start to its hottest working temperature): the null leakage grows about
 // sixfold, which at rest looks exactly like a cross-piston leak of 8e-13.
 double cold_start(double t) { return 55.0 - 40.0 * std::exp(-t / 300.0); }
-// A cooler cycle at working temperature: +-4 K every 5 min, MODEL.md's strongest.
-double cooler(double t) { return 50.0 + 4.0 * std::sin(2.0 * 3.141592653589793 * t / 300.0); }
-// A pump compensator turned down: 17.2 to 14 MPa over 2 s at t = 600 s, up to 20 MPa at 900 s.
-double supply_changes(double t) {
-  if (t < 600.0) return 17.2e6;
-  if (t < 602.0) return 17.2e6 - 3.2e6 * (t - 600.0) / 2.0;
-  if (t < 900.0) return 14e6;
-  if (t < 902.0) return 14e6 + 6e6 * (t - 900.0) / 2.0;
-  return 20e6;
-}
 
 FlowBalanceDetector make() { return FlowBalanceDetector(FlowBalanceOptions{}, kHop); }
 
@@ -50,7 +40,7 @@ TEST(FlowBalanceDrift, CoolerCyclesAreNotALeak) {
   for (const bool with_temp : {false, true}) {
     auto detector = make();
     test::SyntheticRig rig;
-    rig.temperature = cooler;
+    rig.temperature = test::cooler;
     rig.report_temp = with_temp;
     const test::DetectorRun r = test::run_detector(detector, rig, 1800.0);
     EXPECT_LT(r.max_healthy_score, detector.raise_threshold()) << "temp " << with_temp;
@@ -112,7 +102,7 @@ TEST(FlowBalanceDrift, SupplySetPointChangesAreNotALeak) {
   for (const bool with_ps : {false, true}) {
     auto detector = make();
     test::SyntheticRig rig;
-    rig.supply = supply_changes;
+    rig.supply = test::supply_changes;
     rig.report_supply = with_ps;
     rig.onset = 1200.0;
     rig.leak = 1e-12;

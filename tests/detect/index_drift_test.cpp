@@ -22,17 +22,6 @@ constexpr double kHop = 0.04;
 double cool_down(double t) {
   return t < 300.0 ? 50.0 : 30.0 + 20.0 * std::exp(-(t - 300.0) / 300.0);
 }
-// A cooler cycle at working temperature: +-4 K every 5 min, MODEL.md's strongest.
-double cooler(double t) { return 50.0 + 4.0 * std::sin(2.0 * 3.141592653589793 * t / 300.0); }
-// A pump compensator turned down: 17.2 to 14 MPa over 2 s at t = 600 s (the index falls by
-// 10 %), up to 20 MPa at 900 s.
-double supply_changes(double t) {
-  if (t < 600.0) return 17.2e6;
-  if (t < 602.0) return 17.2e6 - 3.2e6 * (t - 600.0) / 2.0;
-  if (t < 900.0) return 14e6;
-  if (t < 902.0) return 14e6 + 6e6 * (t - 900.0) / 2.0;
-  return 20e6;
-}
 
 IndexCusumDetector make(bool both_chambers, IndexCusumOptions options = {}) {
   options.use_p2 = both_chambers;
@@ -74,7 +63,7 @@ TEST(IndexCusumDrift, CoolerCyclesAreNotALeak) {
   for (const bool both : {true, false}) {
     for (const bool with_temp : {false, true}) {
       auto detector = make(both);
-      auto rig = drifting_rig(cooler, with_temp);
+      auto rig = drifting_rig(test::cooler, with_temp);
       const test::DetectorRun r = test::run_detector(detector, rig, 2100.0);
       EXPECT_LT(r.max_healthy_score, 1.0) << "p2 " << both << " temp " << with_temp;
     }
@@ -109,7 +98,7 @@ TEST(IndexCusumDrift, SupplySetPointChangesAreNotALeak) {
        {std::pair{true, false}, std::pair{true, true}, std::pair{false, true}}) {
     auto detector = make(both);
     test::SyntheticRig rig;
-    rig.supply = supply_changes;
+    rig.supply = test::supply_changes;
     rig.report_supply = with_ps;
     rig.onset = 1200.0;
     rig.index_drop = 0.2;
@@ -140,7 +129,7 @@ TEST(IndexCusumDrift, ADropBelowTheMinimumOfInterestIsNotAnAlarm) {
 TEST(IndexCusumDrift, UpdateAllocatesNothingWithTemperatureAndSupply) {
   for (const bool report : {false, true}) {
     auto detector = make(true);
-    auto rig = drifting_rig(cooler, report);
+    auto rig = drifting_rig(test::cooler, report);
     rig.supply = [](double t) { return t < 200.0 ? 17.2e6 : 14e6; };
     rig.report_supply = report;
     rig.onset = 400.0;

@@ -126,4 +126,19 @@ inline DetectorRun run_detector(detect::Detector& detector, SyntheticRig& rig, d
   return result;
 }
 
+// Drifting conditions shared by the detectors' drift tests (MODEL.md's strongest):
+// a cooler cycle at working temperature, +-4 K every 5 min ...
+inline double cooler(double t) {
+  return 50.0 + 4.0 * std::sin(2.0 * 3.141592653589793 * t / 300.0);
+}
+// ... and a pump compensator turned down, 17.2 to 14 MPa over 2 s at t = 600 s, then up to
+// 20 MPa at 900 s.
+inline double supply_changes(double t) {
+  if (t < 600.0) return 17.2e6;
+  if (t < 602.0) return 17.2e6 - 3.2e6 * (t - 600.0) / 2.0;
+  if (t < 900.0) return 14e6;
+  if (t < 902.0) return 14e6 + 6e6 * (t - 900.0) / 2.0;
+  return 20e6;
+}
+
 }  // namespace leakmon::test
