@@ -451,7 +451,6 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     cause_moves = compare(first.parameters.front().name, fe.values[0], fe.value_errors[0],
                           fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
   }
-  d.drifts = named ? cause_moves : calibration_moves;
 
   // `none` only at the floor; a misfit above it is located, and with no constant effect
   // explaining it (none named, or the named one drifting) the cause is `unexplained`.
@@ -475,6 +474,9 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   } else if (!named && d.nrmse_before > nominal_reach) {
     d.cause = "unexplained";
   }
+  // A calibration that moves between the thirds says "drift" only where there is a misfit to
+  // explain (on clean data its optimistic errors can make it move by chance).
+  d.drifts = cause_moves || (d.cause == "unexplained" && calibration_moves);
   if (d.nrmse_after > reach || d.cause == "unexplained") {
     d.unexplained = locate_misfit(predictor, d.extended, d.held_out_used, d.channel_floor);
     d.unexplained->drifts =
