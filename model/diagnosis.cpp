@@ -444,7 +444,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     calibration_moves |= compare("b", ce.b, ee.b, cl.b, el.b, rel);
   }
   bool cause_moves = false;
-  if (named && calibration_moves) {
+  // oil_temperature is itself the model of a change over the capture: its slope is pinned by
+  // the temperature's change, which the last third of a warm-up hardly has, so it is not
+  // asked to hold still (a 20 K warm-up was turned into `unexplained` that way).
+  const bool models_temperature = std::any_of(
+      chosen.begin(), chosen.end(), [](const auto& c) { return c.effect == "oil_temperature"; });
+  if (named && calibration_moves && !models_temperature) {
     const EffectCandidate& first = chosen.front();
     const FitResult fe = fit_model(predictor, early, &first, d.calibrated, with_errors);
     const FitResult fl = fit_model(predictor, late, &first, d.calibrated, with_errors);
