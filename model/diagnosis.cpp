@@ -443,17 +443,30 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
       calibration_moves |= compare("m", ce.m, ee.m, cl.m, el.m, rel);
     calibration_moves |= compare("b", ce.b, ee.b, cl.b, el.b, rel);
   }
+  // The named model's own floor (the noise propagates differently through, say, a leaking
+  // actuator); a named model at its floor leaves no misfit that could drift.
+  const double nominal_floor = d.nrmse_floor;
+  std::array<double, 3> extended_floor = d.channel_floor;
+  if (named) {
+    extended_floor =
+        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed);
+  }
+  const double extended_reach =
+      settings.floor_factor * (extended_floor[0] + extended_floor[1] + extended_floor[2]) / 3.0;
   bool cause_moves = false;
   // oil_temperature is itself the model of a change over the capture: its slope is pinned by
   // the temperature's change, which the last third of a warm-up hardly has, so it is not
   // asked to hold still (a 20 K warm-up was turned into `unexplained` that way).
   const bool models_temperature = std::any_of(
       chosen.begin(), chosen.end(), [](const auto& c) { return c.effect == "oil_temperature"; });
-  if (named && calibration_moves && !models_temperature) {
-    const EffectCandidate& first = chosen.front();
-    const FitResult fe = fit_model(predictor, early, &first, d.calibrated, with_errors);
-    const FitResult fl = fit_model(predictor, late, &first, d.calibrated, with_errors);
-    cause_moves = compare(first.parameters.front().name, fe.values[0], fe.value_errors[0],
+  if (named && calibration_moves && !models_temperature && d.nrmse_after > extended_reach) {
+    // The whole named model on each third (the first cause alone would absorb the others and
+    // move for that reason: two pairs were turned into `unexplained` that way); its first
+    // parameter is the first cause's main one.
+    const EffectCandidate joint = chosen.size() == 1 ? chosen.front() : combine(chosen);
+    const FitResult fe = fit_model(predictor, early, &joint, d.calibrated, with_errors);
+    const FitResult fl = fit_model(predictor, late, &joint, d.calibrated, with_errors);
+    cause_moves = compare(joint.parameters.front().name, fe.values[0], fe.value_errors[0],
                           fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
   }
 
@@ -461,10 +474,9 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // explaining it (none named, or the named one drifting) the cause is `unexplained`.
   // `none` is judged against the nominal model's floor; the leftover misfit of a named model
   // against that model's own (the noise propagates differently through a leaking actuator).
-  const double nominal_reach = settings.floor_factor * d.nrmse_floor;
+  const double nominal_reach = settings.floor_factor * nominal_floor;
   if (named && !cause_moves) {
-    d.channel_floor =
-        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed);
+    d.channel_floor = extended_floor;
     d.nrmse_floor = (d.channel_floor[0] + d.channel_floor[1] + d.channel_floor[2]) / 3.0;
   }
   const double reach = settings.floor_factor * d.nrmse_floor;
