@@ -30,7 +30,12 @@ std::string read_file(const std::string& path) {
 }
 
 Outcome run_leakmon(const std::string& args, const std::string& scratch = "cli_edges") {
-  const std::string log = test::scratch_dir(scratch + "_log") + "/leakmon.log";
+  // One folder per test case: ctest runs the cases as parallel processes, and scratch_dir()
+  // empties the folder it names.
+  const std::string log =
+      test::scratch_dir(scratch + "_log_" +
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+      "/leakmon.log";
   const int status =
       std::system((test::leakmon_binary() + " " + args + " > " + log + " 2>&1").c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};

@@ -19,7 +19,12 @@ struct Outcome {
 };
 
 Outcome run_leakmon(const std::string& args) {
-  const std::string log = test::scratch_dir("cli_help") + "/leakmon.log";
+  // One folder per test case: ctest runs the cases as parallel processes, and scratch_dir()
+  // empties the folder it names.
+  const std::string log =
+      test::scratch_dir(std::string("cli_help_") +
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+      "/leakmon.log";
   const int status =
       std::system((test::leakmon_binary() + " " + args + " > " + log + " 2>&1").c_str());
   std::ifstream in(log);
