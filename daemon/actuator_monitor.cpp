@@ -7,14 +7,13 @@
 #include <limits>
 #include <tuple>
 
+#include "capture/units.hpp"
 #include "detect/factory.hpp"
 
 namespace leakmon::daemon {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// 1 l/min = 1/60000 m^3/s; 1 MPa = 1e6 Pa.
-constexpr double kLpmPerM3s = 60000.0;
 
 double value_at(const Sample& sample, int index) {
   return index < 0 ? kNaN : sample.values[static_cast<std::size_t>(index)];
@@ -282,17 +281,17 @@ io::Event ActuatorMonitor::alarm_event(io::EventKind kind, double t) const {
   const double c = last_decision_.leak_coefficient;
   if (std::isfinite(c)) {
     event.leak_coefficient = c;
-    event.leak_lpm_per_mpa = c * kLpmPerM3s * 1e6;
+    event.leak_lpm_per_mpa = units::lpm_per_mpa(c);
     event.load_pressure = last_load_pressure_;
     // The coefficient is stated at 40 degC when the oil temperature is known; the flow is the
     // one at the present temperature and load.
     const double r =
         std::isfinite(last_decision_.viscosity_ratio) ? last_decision_.viscosity_ratio : 1.0;
-    event.leak_lpm = c * r * last_load_pressure_ * kLpmPerM3s;
+    event.leak_lpm = units::litres_per_minute(c * r * last_load_pressure_);
     const double half_width = last_decision_.leak_coefficient_ci;
     if (std::isfinite(half_width)) {
-      event.leak_lpm_per_mpa_ci95 = half_width * kLpmPerM3s * 1e6;
-      event.leak_lpm_ci95 = half_width * r * last_load_pressure_ * kLpmPerM3s;
+      event.leak_lpm_per_mpa_ci95 = units::lpm_per_mpa(half_width);
+      event.leak_lpm_ci95 = units::litres_per_minute(half_width * r * last_load_pressure_);
     }
   }
   return event;
@@ -336,8 +335,6 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.detector = detector_->name();
   status.state = alarm_.state();
   status.learning = last_decision_.learning;
-  status.learning_seconds_left = last_decision_.learning_hops_left *
-                                 static_cast<double>(config_.features.step) / sample_rate_hz_;
   status.raise_threshold = alarm_.settings().raise_threshold;
   status.clear_threshold = alarm_.settings().clear_threshold;
   status.t = last_t_;
@@ -356,10 +353,16 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.suspended = fed_ < blocked_until_;
   status.suspended_decisions = suspended_decisions_;
   status.relearns = relearns_;
+  // The detector counts its own hops (it does not learn while a faulty channel suspends it);
+  // before its first decision, and after a reload made it learn again, the protection end
+  // the monitor set is what is known.
   if (!status.learning) {
-    status.learning_remaining_s = 0.0;
+    status.learning_seconds_left = 0.0;
+  } else if (!std::isnan(last_decision_.learning_hops_left)) {
+    status.learning_seconds_left = last_decision_.learning_hops_left *
+                                   static_cast<double>(config_.features.step) / sample_rate_hz_;
   } else if (!std::isnan(protected_from_) && !std::isnan(newest_t_)) {
-    status.learning_remaining_s = std::max(0.0, protected_from_ - newest_t_);
+    status.learning_seconds_left = std::max(0.0, protected_from_ - newest_t_);
   }
   status.channels.resize(channels_.size());
   for (std::size_t i = 0; i < channels_.size(); ++i) {

@@ -48,8 +48,9 @@ struct ActuatorStatus {
   std::string detector;
   AlarmState state = AlarmState::normal;
   bool learning = true;
-  double learning_seconds_left = io::kNoValue;  // while learning, when the detector knows
-  double raise_threshold = io::kNoValue;        // the score at which the alarm raises
+  // Source seconds until the detector decides: 0 once it does, NaN before the first sample.
+  double learning_seconds_left = io::kNoValue;
+  double raise_threshold = io::kNoValue;  // the score at which the alarm raises
   double clear_threshold = io::kNoValue;
   double t = io::kNoValue;         // source time of the newest decision
   double index_p1 = io::kNoValue;  // Pa
@@ -67,10 +68,7 @@ struct ActuatorStatus {
   std::vector<ChannelHealth> channels;
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
-  // Source time until the detector decides (0 once it does; NaN before the first sample), and
-  // how often a reload made it learn again.
-  double learning_remaining_s = io::kNoValue;
-  std::uint64_t relearns = 0;
+  std::uint64_t relearns = 0;             // how often a reload made the detector learn again
 };
 
 using EventPublisher = std::function<void(const io::Event&)>;

@@ -237,21 +237,7 @@ const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string
   return nullptr;
 }
 
-// Relative paths in a configuration are relative to its file, so that a configuration and its
-// data can move together (and a service's working directory does not matter).
-static std::string resolve_path(const config::ConfigNode& node, const std::string& path) {
-  if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
-  return (std::filesystem::path(node.source()).parent_path() / path).lexically_normal().string();
-}
-
-std::string default_state_directory() {
-  // systemd passes a colon-separated list when the unit names several state directories.
-  if (const char* env = std::getenv("STATE_DIRECTORY"); env != nullptr && *env != '\0') {
-    const std::string list(env);
-    return list.substr(0, list.find(':'));
-  }
-  return "/var/lib/leakmon";
-}
+using config::resolve_path;
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
   root.expect_keys({"drivers", "sampling", "actuators", "events", "recording", "state", "metrics",

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "config/paths.hpp"
 #include "config/yaml_reader.hpp"
 #include "daemon/alarm.hpp"
 #include "detect/sensor_plausibility.hpp"
@@ -74,9 +75,6 @@ struct StateConfig {
   std::optional<config::ConfigNode> where;  // `state.directory` when given
 };
 
-// $STATE_DIRECTORY (set by systemd for StateDirectory=leakmon), else /var/lib/leakmon.
-std::string default_state_directory();
-
 struct MetricsConfig {
   std::string address = "127.0.0.1";        // an IPv4 address (names are not resolved)
   int port = 9187;                          // 0 disables the metrics and control endpoint
@@ -99,7 +97,7 @@ struct DaemonConfig {
   std::string event_log;  // JSON-lines file; empty: none
   std::optional<config::ConfigNode> event_log_where;
   RecordingConfig recording;
-  StateConfig state{default_state_directory(), 60.0, std::nullopt};
+  StateConfig state{config::default_state_directory(), 60.0, std::nullopt};
   MetricsConfig metrics;
   std::vector<config::ConfigNode> outputs;
   // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <ctime>
 
+#include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/http_router.hpp"
@@ -86,12 +87,12 @@ void Daemon::attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& 
   if (attach) {
     const Worker* worker = worker_.get();
     source = [worker] {
-      constexpr double kLpmPerMpa = 60000.0 * 1e6;  // m^3/(s Pa) -> l/min/MPa
       std::vector<io::ActuatorReading> readings;
       for (const auto& a : worker->status()) {
-        readings.push_back({a.name, a.t, a.index_p1, a.score, a.leak_coefficient * kLpmPerMpa,
-                            a.leak_coefficient_ci * kLpmPerMpa, std::string(to_string(a.state)),
-                            a.learning});
+        readings.push_back({a.name, a.t, a.index_p1, a.score,
+                            units::lpm_per_mpa(a.leak_coefficient),
+                            units::lpm_per_mpa(a.leak_coefficient_ci),
+                            std::string(to_string(a.state)), a.learning});
       }
       return readings;
     };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "capture/units.hpp"
 #include "daemon/daemon.hpp"
 
 namespace leakmon::daemon {
@@ -131,13 +132,13 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   for (const auto& a : actuators) {
     out.sample("leakmon_detector_learning", label("actuator", a.name), flag(a.learning));
   }
-  out.family("leakmon_learning_remaining_seconds",
+  out.family("leakmon_learning_seconds_lefteconds",
              "source time until the detector decides (0: it decides; after a reload that "
              "invalidated what it learned, until it has learned again)",
              "gauge");
   for (const auto& a : actuators) {
-    out.sample("leakmon_learning_remaining_seconds", label("actuator", a.name),
-               a.learning_remaining_s);
+    out.sample("leakmon_learning_seconds_lefteconds", label("actuator", a.name),
+               a.learning_seconds_left);
   }
   out.family("leakmon_relearn_total",
              "reloads that changed an option the learned state depends on (learning started over)",
@@ -154,18 +155,17 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   }
   // FORMATS.md "Operator view and fleet": the leak size in l/min/MPa (at 40 degC where the oil
   // temperature is acquired), NaN until the detector has one; its 95 % half-width beside it.
-  constexpr double kLpmPerMpa = 60000.0 * 1e6;
   out.family("leakmon_leak_lpm_per_mpa",
              "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel", "gauge");
   for (const auto& a : actuators) {
     out.sample("leakmon_leak_lpm_per_mpa", label("actuator", a.name),
-               a.leak_coefficient * kLpmPerMpa);
+               units::lpm_per_mpa(a.leak_coefficient));
   }
   out.family("leakmon_leak_lpm_per_mpa_ci95", "95 % half-width of the leak size [l/min/MPa]",
              "gauge");
   for (const auto& a : actuators) {
     out.sample("leakmon_leak_lpm_per_mpa_ci95", label("actuator", a.name),
-               a.leak_coefficient_ci * kLpmPerMpa);
+               units::lpm_per_mpa(a.leak_coefficient_ci));
   }
   out.family("leakmon_oil_temperature_celsius", "oil temperature (hop mean of the temp channel)",
              "gauge");

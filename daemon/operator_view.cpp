@@ -7,9 +7,11 @@
 #include <cstdlib>
 #include <iterator>
 
+#include "capture/units.hpp"
 #include "daemon/daemon.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/web_assets.hpp"
+#include "io/event_json.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -18,20 +20,7 @@ double unix_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-void append_string(std::string& out, std::string_view text) {
-  out += '"';
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      fmt::format_to(std::back_inserter(out), "\\u{:04x}", static_cast<unsigned>(c));
-    } else {
-      out += c;
-    }
-  }
-  out += '"';
-}
+using io::append_json_string;
 
 // JSON has no NaN: a value the daemon does not have yet is null. Seven digits are more than
 // any sensor resolves; times (unix seconds) keep milliseconds.
@@ -62,11 +51,13 @@ class JsonFields {
   std::string& key(std::string_view name) {
     if (!first_) out_ += ',';
     first_ = false;
-    append_string(out_, name);
+    append_json_string(out_, name);
     out_ += ':';
     return out_;
   }
-  void string(std::string_view name, std::string_view value) { append_string(key(name), value); }
+  void string(std::string_view name, std::string_view value) {
+    append_json_string(key(name), value);
+  }
   void number(std::string_view name, double value) { append_number(key(name), value); }
   void time(std::string_view name, double value) { append_time(key(name), value); }
   void integer(std::string_view name, std::uint64_t value) {
@@ -302,8 +293,8 @@ std::string OperatorView::trend_json(double since) const {
     item.number("score", a.score);
     item.number("raise_threshold", a.raise_threshold);
     item.number("clear_threshold", a.clear_threshold);
-    item.number("leak_lpm_per_mpa", a.leak_coefficient * 60000.0 * 1e6);
-    item.number("leak_lpm_per_mpa_ci95", a.leak_coefficient_ci * 60000.0 * 1e6);
+    item.number("leak_lpm_per_mpa", units::lpm_per_mpa(a.leak_coefficient));
+    item.number("leak_lpm_per_mpa_ci95", units::lpm_per_mpa(a.leak_coefficient_ci));
     item.number("p1", a.p1);
     item.number("p2", a.p2);
     item.number("oil_temperature", a.oil_temperature);

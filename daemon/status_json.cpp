@@ -6,69 +6,18 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "capture/units.hpp"
 #include "daemon/daemon.hpp"
+#include "io/event_json.hpp"
 
 namespace leakmon::daemon {
 namespace {
 
-// Length of the UTF-8 sequence starting at text[i], or 0 when it is not one.
-std::size_t utf8_length(std::string_view text, std::size_t i) {
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char lead = byte(i);
-  std::size_t length = 0;
-  unsigned min = 0;
-  if (lead < 0x80) return 1;
-  if (lead >= 0xc2 && lead <= 0xdf) {
-    length = 2;
-    min = 0x80;
-  } else if (lead >= 0xe0 && lead <= 0xef) {
-    length = 3;
-    min = 0x800;
-  } else if (lead >= 0xf0 && lead <= 0xf4) {
-    length = 4;
-    min = 0x10000;
-  } else {
-    return 0;
-  }
-  if (i + length > text.size()) return 0;
-  unsigned code = lead & (0x7fu >> length);
-  for (std::size_t k = 1; k < length; ++k) {
-    if ((byte(i + k) & 0xc0) != 0x80) return 0;
-    code = (code << 6) | (byte(i + k) & 0x3fu);
-  }
-  if (code < min || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;
-  return length;
-}
+using io::json_string;
 
 std::string flag(bool on) { return on ? "true" : "false"; }
 
 }  // namespace
-
-std::string json_string(std::string_view text) {
-  std::string out = "\"";
-  for (std::size_t i = 0; i < text.size();) {
-    const char c = text[i];
-    const std::size_t length = utf8_length(text, i);
-    if (length == 0) {
-      out += "\\ufffd";
-      ++i;
-      continue;
-    }
-    if (length > 1) {
-      out.append(text.substr(i, length));
-    } else if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(c)));
-    } else {
-      out += c;
-    }
-    i += length;
-  }
-  out += '"';
-  return out;
-}
 
 std::string json_number(double value) {
   return std::isfinite(value) ? fmt::format("{}", value) : "null";
@@ -113,7 +62,6 @@ std::string Daemon::status_json() const {
         health.reconnects, health.stale_values);
   }
   out += "],\"actuators\":[";
-  constexpr double kLpmPerMpa = 60000.0 * 1e6;
   const auto actuators = worker_->status();
   for (std::size_t i = 0; i < actuators.size(); ++i) {
     const auto& a = actuators[i];
@@ -130,8 +78,8 @@ std::string Daemon::status_json() const {
         json_number(a.learning ? a.learning_seconds_left : NAN), json_number(a.t),
         json_number(a.index_p1), json_number(a.index_p2), json_number(a.score),
         json_number(a.raise_threshold), json_number(a.clear_threshold), json_number(a.baseline),
-        json_number(a.leak_coefficient * kLpmPerMpa),
-        json_number(a.leak_coefficient_ci * kLpmPerMpa), json_number(a.oil_temperature),
+        json_number(units::lpm_per_mpa(a.leak_coefficient)),
+        json_number(units::lpm_per_mpa(a.leak_coefficient_ci)), json_number(a.oil_temperature),
         json_string(a.alarm), json_string(to_string(a.state)), flag(a.suspended), a.decisions,
         a.gap_samples);
     for (std::size_t k = 0; k < a.channels.size(); ++k) {

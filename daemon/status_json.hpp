@@ -8,9 +8,6 @@
 
 namespace leakmon::daemon {
 
-// `text` as a JSON string literal: quotes, backslash and control characters escaped, bytes that
-// are not UTF-8 replaced by U+FFFD (the result is always valid JSON text).
-std::string json_string(std::string_view text);
 // A JSON number, or null for NaN and infinities (JSON has neither).
 std::string json_number(double value);
 

@@ -1,4 +1,5 @@
 #include "daemon/trend_history.hpp"
+#include "capture/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +9,6 @@ namespace leakmon::daemon {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// 1 m^3/(s Pa) = 60000 l/min per 1e-6 MPa.
-constexpr double kLpmPerMpa = 60000.0 * 1e6;
 
 TrendPoint point_of(double unix_time, const ActuatorStatus& a) {
   TrendPoint p;
@@ -18,8 +17,8 @@ TrendPoint point_of(double unix_time, const ActuatorStatus& a) {
   p.index_p2 = a.index_p2;
   p.score = a.score;
   p.raise_threshold = a.raise_threshold;
-  p.leak_lpm_per_mpa = a.leak_coefficient * kLpmPerMpa;
-  p.leak_lpm_per_mpa_ci95 = a.leak_coefficient_ci * kLpmPerMpa;
+  p.leak_lpm_per_mpa = units::lpm_per_mpa(a.leak_coefficient);
+  p.leak_lpm_per_mpa_ci95 = units::lpm_per_mpa(a.leak_coefficient_ci);
   p.p1 = a.p1;
   p.p2 = a.p2;
   p.oil_temperature = a.oil_temperature;

@@ -11,8 +11,13 @@
 namespace leakmon::io {
 namespace {
 
-// Always valid UTF-8 JSON text: quotes, backslashes and every control character (C0, DEL, C1:
-// ESC and CSI included) escaped, bytes that are not UTF-8 replaced by U+FFFD.
+bool is_alarm(EventKind kind) {
+  return kind == EventKind::alarm_raised || kind == EventKind::alarm_cleared ||
+         kind == EventKind::alarm_acknowledged;
+}
+
+}  // namespace
+
 void append_json_string(std::string& out, std::string_view text) {
   out += '"';
   std::size_t i = 0;
@@ -52,12 +57,11 @@ void append_json_string(std::string& out, std::string_view text) {
   out += '"';
 }
 
-bool is_alarm(EventKind kind) {
-  return kind == EventKind::alarm_raised || kind == EventKind::alarm_cleared ||
-         kind == EventKind::alarm_acknowledged;
+std::string json_string(std::string_view text) {
+  std::string out;
+  append_json_string(out, text);
+  return out;
 }
-
-}  // namespace
 
 void JsonObject::string(std::string_view key_name, std::string_view value) {
   if (value.empty()) return;

@@ -13,6 +13,12 @@ namespace leakmon::io {
 // in kPa (as FORMATS.md shows it); leak sizes in l/min/MPa and l/min.
 std::string to_json_line(const Event& event);
 
+// `text` as a JSON string literal appended to `out`: quotes, backslashes and every control
+// character (C0, DEL, C1: ESC and CSI included) escaped, bytes that are not UTF-8 replaced by
+// U+FFFD, so the result is always valid UTF-8 JSON whatever a peer or a config put in.
+void append_json_string(std::string& out, std::string_view text);
+std::string json_string(std::string_view text);
+
 // Builds a flat JSON object: strings escaped, empty strings and non-finite numbers left out.
 class JsonObject {
  public:

@@ -6,13 +6,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "capture/units.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace leakmon::sim {
 namespace {
-
-// MODEL.md's effect table converts leak sizes quoted in l/min/MPa: 1 l/min = 1/60000 m^3/s.
-constexpr double kLitresPerMinutePerMPa = 1.0 / 60000.0 / 1e6;
 
 struct NumberSpec {
   std::string_view name;
@@ -343,7 +341,7 @@ Scenario paper_experiment(std::string_view name, ControllerKind controller, doub
   s.duration_s = duration_s;
   s.seed = seed;
   s.effects.internal_leakage =
-      InternalLeakage{leak_lpm_per_mpa * kLitresPerMinutePerMPa, onset_s, 0.0};
+      InternalLeakage{units::cubic_metres_per_second_pascal(leak_lpm_per_mpa), onset_s, 0.0};
   return s;
 }
 

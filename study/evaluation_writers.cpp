@@ -8,12 +8,11 @@
 #include <cmath>
 #include <string>
 
+#include "capture/units.hpp"
 #include "study/evaluation_summary.hpp"
 
 namespace leakmon::study {
 namespace {
-
-constexpr double kLitresPerMinutePerMPa = 60000.0 * 1e6;  // m^3/(s Pa) -> l/min/MPa
 
 std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
 
@@ -216,7 +215,7 @@ void write_summaries(const std::filesystem::path& dir, const EvaluationOptions& 
           if (design && size > 0.0) {
             f_md.print(
                 "| {} | {} | {:.2g} | {:.3f} | {}/{} ({:.0f} %) | {} | {:.2f} ({:.1f}) | {} |\n",
-                all[c].label, controller, size, size * kLitresPerMinutePerMPa, rates.detected,
+                all[c].label, controller, size, units::lpm_per_mpa(size), rates.detected,
                 rates.leak_runs, 100.0 * rates.detection_rate(),
                 std::isnan(rates.median_delay()) ? std::string("-")
                                                  : fmt::format("{:.1f}", rates.median_delay()),

@@ -20,6 +20,7 @@
 #include <system_error>
 #include <thread>
 
+#include "config/paths.hpp"
 #include "io/event_json.hpp"
 
 namespace leakmon::io::mqtt {
@@ -28,20 +29,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-std::string resolve_path(const config::ConfigNode& node, const std::string& path) {
-  if (path.empty() || std::filesystem::path(path).is_absolute()) return path;
-  return (std::filesystem::path(node.source()).parent_path() / path).lexically_normal().string();
-}
-
-// Where the daemon keeps its learned state by default (daemon/config.cpp): systemd's
-// STATE_DIRECTORY, else /var/lib/leakmon.
-std::string default_state_directory() {
-  if (const char* env = std::getenv("STATE_DIRECTORY"); env != nullptr && *env != '\0') {
-    const std::string list(env);
-    return list.substr(0, list.find(':'));
-  }
-  return "/var/lib/leakmon";
-}
+using config::default_state_directory;
+using config::resolve_path;
 
 std::string readable_file(const config::ConfigNode& node, const config::ConfigNode& field,
                           bool directory) {

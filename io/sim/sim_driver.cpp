@@ -1,4 +1,5 @@
 #include "io/sim/sim_driver.hpp"
+#include "capture/units.hpp"
 
 #include <fmt/format.h>
 
@@ -8,9 +9,6 @@
 
 namespace leakmon::io {
 namespace {
-
-// 1 l/min/MPa = (1/60000 m^3/s) / 1e6 Pa.
-constexpr double kM3sPaPerLpmMpa = 1.0 / 60000.0 / 1e6;
 
 double field(const sim::RigSample& s, std::size_t index) {
   switch (index) {
@@ -103,8 +101,10 @@ std::unique_ptr<Driver> make_sim_driver(const config::ConfigNode& node) {
     if (leak->has("C_L") == leak->has("lpm_per_mpa")) {
       leak->fail("give the leak size as exactly one of C_L [m^3/(s Pa)] or lpm_per_mpa");
     }
-    injected.C_L = leak->has("C_L") ? leak->get_double("C_L", 0.0, 1e-9)
-                                    : leak->get_double("lpm_per_mpa", 0.0, 100.0) * kM3sPaPerLpmMpa;
+    injected.C_L =
+        leak->has("C_L")
+            ? leak->get_double("C_L", 0.0, 1e-9)
+            : units::cubic_metres_per_second_pascal(leak->get_double("lpm_per_mpa", 0.0, 100.0));
     injected.onset_s = leak->get_double("onset_s", 0.0, 0.0, 1e7);
     injected.ramp_s = leak->get_double("ramp_s", 0.0, 0.0, 1e4);
     settings.leak = injected;

@@ -15,37 +15,15 @@
 #include <thread>
 
 #include "daemon/http_endpoint.hpp"
+#include "tests/daemon/raw_http.hpp"
 
 namespace leakmon::daemon {
 namespace {
 
 using namespace std::chrono_literals;
 
-int connect_to(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
-  return fd;
-}
-
-std::string raw(int port, const std::string& request) {
-  const int fd = connect_to(port);
-  ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
-  std::string reply;
-  char buffer[4096];
-  while (true) {
-    pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, 10000) <= 0) break;
-    const ssize_t n = ::recv(fd, buffer, sizeof(buffer), 0);
-    if (n <= 0) break;
-    reply.append(buffer, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  return reply;
-}
+using test::connect_loopback;
+using test::raw_http_status_line;
 
 TEST(HttpEndpoint, HandlerSeesDecodedParametersAndLimitsAnswerFirst) {
   std::atomic<int> calls{0};
@@ -74,8 +52,9 @@ TEST(HttpEndpoint, HandlerSeesDecodedParametersAndLimitsAnswerFirst) {
   EXPECT_EQ(http_request("127.0.0.1", endpoint.port(), "GET", "/?x=%4").status, 400);
   std::string many = "GET / HTTP/1.1\r\nHost: x\r\n";
   for (int i = 0; i < 200; ++i) many += "X-" + std::to_string(i) + ": y\r\n";
-  EXPECT_EQ(raw(endpoint.port(), many + "\r\n").rfind("HTTP/1.1 431 ", 0), 0u);
-  EXPECT_EQ(raw(endpoint.port(), "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 5000\r\n\r\n")
+  EXPECT_EQ(raw_http_status_line(endpoint.port(), many + "\r\n").rfind("HTTP/1.1 431 ", 0), 0u);
+  EXPECT_EQ(raw_http_status_line(endpoint.port(),
+                                 "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 5000\r\n\r\n")
                 .rfind("HTTP/1.1 413 ", 0),
             0u);
   EXPECT_EQ(calls.load(), 2);  // none of the refused requests reached the handler
@@ -92,7 +71,8 @@ TEST(HttpEndpoint, DripFeedingClientIsCutOffByTheDeadline) {
         return HttpResponse{200, "text/plain", "x"};
       },
       limits);
-  const int fd = connect_to(endpoint.port());
+  const int fd = connect_loopback(endpoint.port());
+  ASSERT_GE(fd, 0);
   const std::string request = "GET / HTTP/1.1\r\nHost: x\r\n\r\n";
   const auto start = std::chrono::steady_clock::now();
   bool closed = false;

@@ -14,42 +14,15 @@
 
 #include "daemon/http_endpoint.hpp"
 #include "tests/daemon/daemon_process.hpp"
+#include "tests/daemon/raw_http.hpp"
 
 namespace leakmon::daemon {
 namespace {
 
 using namespace std::chrono_literals;
 
-// Sends `request` as raw bytes and returns the status line ("" when the daemon closed without
-// one); for requests http_request() cannot send (oversized, many headers, odd methods).
-std::string status_line(int port, const std::string& request) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0) {
-    ::close(fd);
-    return "connect failed";
-  }
-  std::string_view rest = request;
-  while (!rest.empty()) {
-    const ssize_t n = ::send(fd, rest.data(), rest.size(), MSG_NOSIGNAL);
-    if (n <= 0) break;  // the daemon may answer and close before reading everything
-    rest.remove_prefix(static_cast<std::size_t>(n));
-  }
-  std::string reply;
-  char buffer[4096];
-  while (reply.find("\r\n") == std::string::npos) {
-    pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, 10000) <= 0) break;
-    const ssize_t n = ::recv(fd, buffer, sizeof(buffer), 0);
-    if (n <= 0) break;
-    reply.append(buffer, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  return reply.substr(0, reply.find("\r\n"));
-}
+// For requests http_request() cannot send (oversized, many headers, odd methods).
+const auto status_line = test::raw_http_status_line;
 
 std::string header_value(const HttpResponse& response, const std::string& name) {
   for (const auto& [key, value] : response.headers) {

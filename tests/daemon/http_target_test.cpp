@@ -8,6 +8,7 @@
 #include "daemon/http_router.hpp"
 #include "daemon/http_target.hpp"
 #include "daemon/status_json.hpp"
+#include "io/event_json.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -140,7 +141,8 @@ TEST(HttpRouter, StatusFormatFromParameterOrAccept) {
 }
 
 TEST(StatusJson, StringsAreAlwaysValidJsonAndNumbersNeverNan) {
-  EXPECT_EQ(json_string("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\u000a\\u0001\"");
+  using io::json_string;
+  EXPECT_EQ(json_string("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\n\\u0001\"");
   EXPECT_EQ(json_string("\xc3\xa9"), "\"\xc3\xa9\"");
   EXPECT_EQ(json_string("x\xff\xc3"), "\"x\\ufffd\\ufffd\"");           // invalid, truncated
   EXPECT_EQ(json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"");  // a surrogate

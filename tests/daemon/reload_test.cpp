@@ -93,7 +93,7 @@ ReloadRun run_with_reload(const DaemonConfig& initial, const DaemonConfig& reloa
   run.events = sink.events;
   for (const auto& a : worker.status()) {
     run.metrics +=
-        fmt::format("{} relearns {} remaining {}\n", a.name, a.relearns, a.learning_remaining_s);
+        fmt::format("{} relearns {} remaining {}\n", a.name, a.relearns, a.learning_seconds_left);
   }
   return run;
 }
