@@ -152,6 +152,8 @@ void Daemon::start() {
     std::vector<std::string> group_names;
     for (const auto& group : groups_) group_names.push_back(group->config.name);
     operator_view_ = std::make_unique<OperatorView>(config_, group_names);
+    // The page shows what happened before a restart, starting with the log's newest events.
+    if (!config_.event_log.empty()) operator_view_->restore_events(config_.event_log);
   }
   sinks_ = build_sinks(config_);
   worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
@@ -170,6 +172,14 @@ void Daemon::start() {
         if (actuator == state.actuator && fingerprint == state.fingerprint) {
           state_saved_unix_[actuator] = state.saved_unix;
         }
+      }
+    }
+    if (operator_view_) {
+      const double unix_now =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
+      for (const auto& warning : operator_view_->restore_history(*state_store_, unix_now)) {
+        spdlog::warn("{}", warning);
       }
     }
     spdlog::info("learned state kept under {} (saved every {} s and at shutdown)",
@@ -243,6 +253,13 @@ void Daemon::start() {
 
 void Daemon::save_state() {
   if (!state_store_ || !worker_) return;
+  if (operator_view_) {
+    try {
+      operator_view_->save_history(*state_store_);
+    } catch (const std::exception& e) {
+      spdlog::warn("cannot save the live page's trend history: {}", e.what());
+    }
+  }
   for (const auto& state : worker_->export_states()) {
     try {
       state_store_->save(state);

@@ -2,12 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <iterator>
+#include <limits>
+#include <sstream>
 
 #include "capture/units.hpp"
+#include "config/yaml_reader.hpp"
 #include "daemon/daemon.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/web_assets.hpp"
@@ -164,6 +172,12 @@ void RecentEvents::add(const io::Event& event) {
   while (lines_.size() > capacity_) lines_.pop_front();
 }
 
+void RecentEvents::add_line(std::string line) {
+  std::lock_guard lock(mutex_);
+  lines_.emplace_back(next_++, std::move(line));
+  while (lines_.size() > capacity_) lines_.pop_front();
+}
+
 std::string RecentEvents::json_after(std::uint64_t after) const {
   std::lock_guard lock(mutex_);
   std::string out = fmt::format("{{\"next\":{},\"events\":[", next_);
@@ -254,6 +268,96 @@ void OperatorView::sample(double unix_time) {
 void OperatorView::set_ack_token(const std::string& token) {
   std::lock_guard lock(mutex_);
   ack_token_ = token;
+}
+
+void OperatorView::save_history(const StateStore& store) const {
+  std::vector<std::pair<std::string, std::string>> files;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& series : history_.actuators()) {
+      if (series.points.size() > 0) files.emplace_back(series.name, encode_trend(series.points));
+    }
+  }
+  for (const auto& [actuator, text] : files)
+    store.write_atomically(store.trend_file_of(actuator), text);
+}
+
+std::vector<std::string> OperatorView::restore_history(const StateStore& store, double unix_now) {
+  std::vector<std::string> warnings;
+  const double oldest = unix_now - static_cast<double>(history_.capacity()) * interval_s_;
+  std::vector<std::string> names;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& series : history_.actuators()) names.push_back(series.name);
+  }
+  for (const auto& name : names) {
+    const std::filesystem::path path = store.trend_file_of(name);
+    std::error_code error;
+    if (!std::filesystem::exists(path, error)) continue;
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::vector<TrendPoint> points;
+    try {
+      if (!in) throw std::runtime_error("cannot be read");
+      points = decode_trend(text.str());
+    } catch (const std::exception& e) {
+      warnings.push_back(fmt::format("{}: trend history set aside: {}", path.string(), e.what()));
+      continue;
+    }
+    std::erase_if(points, [&](const TrendPoint& p) {
+      return !(p.unix_time >= oldest && p.unix_time < unix_now);
+    });
+    if (points.empty()) continue;
+    // A point of nothing where the daemon was down, so the page breaks its lines there instead
+    // of drawing a straight one across the downtime.
+    TrendPoint gap;
+    gap.unix_time =
+        std::min(points.back().unix_time + interval_s_, 0.5 * (points.back().unix_time + unix_now));
+    for (double* value :
+         {&gap.index_p1, &gap.index_p2, &gap.score, &gap.raise_threshold, &gap.leak_lpm_per_mpa,
+          &gap.leak_lpm_per_mpa_ci95, &gap.p1, &gap.p2, &gap.oil_temperature}) {
+      *value = std::numeric_limits<double>::quiet_NaN();
+    }
+    gap.channel_status.fill(TrendPoint::kNoChannel);
+    points.push_back(gap);
+    std::lock_guard lock(mutex_);
+    history_.restore(name, points);
+  }
+  return warnings;
+}
+
+std::size_t OperatorView::restore_events(const std::string& event_log) {
+  std::ifstream in(event_log, std::ios::binary);
+  if (!in) return 0;
+  // Only the tail: a log of months must not be read whole to show a hundred lines.
+  constexpr std::streamoff kTail = 256 * 1024;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(size > kTail ? size - kTail : 0);
+  std::string line;
+  if (size > kTail) std::getline(in, line);  // most likely the second half of a line
+  std::deque<std::string> newest;
+  while (std::getline(in, line)) {
+    if (line.size() < 2 || line.front() != '{' || line.back() != '}') continue;
+    bool valid = true;
+    for (std::size_t i = 0; i < line.size() && valid;) {
+      unsigned code = 0;
+      const std::size_t length = config::utf8_sequence(line, i, code);
+      valid = length > 0 && code >= 0x20;
+      i += std::max<std::size_t>(length, 1);
+    }
+    if (!valid) continue;
+    try {
+      if (!YAML::Load(line).IsMap()) continue;
+    } catch (const YAML::Exception&) {
+      continue;
+    }
+    newest.push_back(std::move(line));
+    if (newest.size() > kRecentEvents) newest.pop_front();
+  }
+  for (auto& kept : newest) events_->add_line(std::move(kept));
+  return newest.size();
 }
 
 std::size_t OperatorView::history_bytes() const {

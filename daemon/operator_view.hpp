@@ -22,6 +22,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/http_endpoint.hpp"
+#include "daemon/state_store.hpp"
 #include "daemon/trend_history.hpp"
 #include "io/event.hpp"
 
@@ -33,6 +34,8 @@ class RecentEvents {
  public:
   explicit RecentEvents(std::size_t capacity) : capacity_(capacity) {}
   void add(const io::Event& event);
+  // A line of the event log as it was written (restored after a restart).
+  void add_line(std::string line);
   // {"next": SEQ, "events": [{"seq": N, "event": {...}}, ...]} for the events after `after`.
   std::string json_after(std::uint64_t after) const;
 
@@ -73,6 +76,17 @@ class OperatorView {
   void sample(double unix_time);
   // A reload may change the token.
   void set_ack_token(const std::string& token);
+
+  // The page's memory across a restart. save_history() writes every actuator's trend into
+  // `store`'s directory (atomically, throws std::runtime_error naming the file);
+  // restore_history() puts back the points of the last `trend_seconds` before `unix_now`, with
+  // a gap where the daemon was down, and returns a warning for each file it set aside.
+  void save_history(const StateStore& store) const;
+  std::vector<std::string> restore_history(const StateStore& store, double unix_now);
+  // The newest events of the event log (a JSON-lines file, possibly being appended to by
+  // nobody else) into the page's recent events; lines that are not whole JSON objects are
+  // skipped. Returns how many were taken.
+  std::size_t restore_events(const std::string& event_log);
 
   // The page, its assets and its data; a 401 for /ack without the configured token; nullopt
   // for everything else (the daemon's own routes).

@@ -21,6 +21,7 @@ namespace {
 
 constexpr std::string_view kMagic = "leakmon-state";
 constexpr std::string_view kSuffix = ".state";
+constexpr std::string_view kTrendSuffix = ".trend.csv";
 
 std::string fnv1a64(std::string_view text) {
   std::uint64_t hash = 1469598103934665603ull;
@@ -215,17 +216,24 @@ std::filesystem::path StateStore::file_of(const std::string& actuator) const {
   return directory_ / (file_stem(actuator) + std::string(kSuffix));
 }
 
+std::filesystem::path StateStore::trend_file_of(const std::string& actuator) const {
+  return directory_ / (file_stem(actuator) + std::string(kTrendSuffix));
+}
+
 void StateStore::save(const ActuatorState& state) const {
+  write_atomically(file_of(state.actuator), encode_state(state));
+}
+
+void StateStore::write_atomically(const std::filesystem::path& target,
+                                  const std::string& text) const {
   std::error_code error;
   std::filesystem::create_directories(directory_, error);
   if (error) {
     throw std::runtime_error(fmt::format("{}: cannot create the state directory: {}",
                                          directory_.string(), error.message()));
   }
-  const std::filesystem::path target = file_of(state.actuator);
   const std::filesystem::path temporary =
       target.string() + fmt::format(".tmp.{}", static_cast<long>(::getpid()));
-  const std::string text = encode_state(state);
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
   if (fd < 0) fail_io(temporary, "cannot create");
   try {

@@ -57,6 +57,14 @@ class StateStore {
   explicit StateStore(std::filesystem::path directory);
   const std::filesystem::path& directory() const { return directory_; }
   std::filesystem::path file_of(const std::string& actuator) const;
+  // The live page's trend of the actuator (OperatorView::save_history): beside its state, but
+  // not part of it (`leakmon state reset` forgets what was learned, not what was seen).
+  std::filesystem::path trend_file_of(const std::string& actuator) const;
+
+  // Replaces `target` (a file in the directory) by `text` atomically: temporary file, fsync,
+  // rename, fsync of the directory, which is created when missing. Throws std::runtime_error
+  // naming the file and the system error, leaving the previous file as it was.
+  void write_atomically(const std::filesystem::path& target, const std::string& text) const;
 
   // Atomic replacement of the actuator's file; creates the directory. Throws std::runtime_error
   // (naming the file and the system error) and leaves the previous file as it was.

@@ -1,9 +1,15 @@
 #include "daemon/trend_history.hpp"
-#include "capture/units.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <stdexcept>
+
+#include "capture/units.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -32,7 +38,139 @@ TrendPoint point_of(double unix_time, const ActuatorStatus& a) {
   return p;
 }
 
+constexpr std::string_view kTrendMagic = "# leakmon trend ";
+constexpr int kTrendVersion = 1;
+constexpr std::string_view kTrendColumns =
+    "unix_time,index_p1,index_p2,score,raise_threshold,leak_lpm_per_mpa,leak_lpm_per_mpa_ci95,"
+    "p1,p2,oil_temperature,alarm,learning,suspended,channel_1,channel_2,channel_3";
+constexpr std::size_t kTrendFields = 16;
+
+double parse_number(std::string_view field, std::size_t line, std::string_view column) {
+  const std::string text(field);
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE) {
+    throw std::runtime_error(
+        fmt::format("line {}, field {}: '{}' is not a number", line, column, text.substr(0, 40)));
+  }
+  return value;
+}
+
+std::uint8_t parse_small(std::string_view field, std::size_t line, std::string_view column,
+                         unsigned max) {
+  const double value = parse_number(field, line, column);
+  if (!(value >= 0.0 && value <= max) || value != std::floor(value)) {
+    throw std::runtime_error(
+        fmt::format("line {}, field {}: {} is not an integer 0..{}", line, column, value, max));
+  }
+  return static_cast<std::uint8_t>(value);
+}
+
 }  // namespace
+
+std::string encode_trend(const FixedRing<TrendPoint>& points) {
+  std::string out = fmt::format("{}{}\n{}\n", kTrendMagic, kTrendVersion, kTrendColumns);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const TrendPoint& p = points[i];
+    fmt::format_to(
+        std::back_inserter(out),
+        "{:.3f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
+        "{}\n",
+        p.unix_time, p.index_p1, p.index_p2, p.score, p.raise_threshold, p.leak_lpm_per_mpa,
+        p.leak_lpm_per_mpa_ci95, p.p1, p.p2, p.oil_temperature, p.alarm, p.learning ? 1 : 0,
+        p.suspended ? 1 : 0, p.channel_status[0], p.channel_status[1], p.channel_status[2]);
+  }
+  return out;
+}
+
+std::vector<TrendPoint> decode_trend(std::string_view text) {
+  std::vector<TrendPoint> points;
+  std::size_t line_number = 0;
+  std::vector<std::string_view> fields;
+  static constexpr std::string_view kNames[kTrendFields] = {"unix_time",
+                                                            "index_p1",
+                                                            "index_p2",
+                                                            "score",
+                                                            "raise_threshold",
+                                                            "leak_lpm_per_mpa",
+                                                            "leak_lpm_per_mpa_ci95",
+                                                            "p1",
+                                                            "p2",
+                                                            "oil_temperature",
+                                                            "alarm",
+                                                            "learning",
+                                                            "suspended",
+                                                            "channel_1",
+                                                            "channel_2",
+                                                            "channel_3"};
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    const std::string_view line = text.substr(0, end);
+    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
+    ++line_number;
+    if (line_number == 1) {
+      if (line.substr(0, kTrendMagic.size()) != kTrendMagic) {
+        throw std::runtime_error("line 1: not a leakmon trend file");
+      }
+      const double version = parse_number(line.substr(kTrendMagic.size()), 1, "version");
+      if (version != kTrendVersion) {
+        throw std::runtime_error(fmt::format(
+            "line 1: format version {} (this leakmon reads version {})", version, kTrendVersion));
+      }
+      continue;
+    }
+    if (line_number == 2) {
+      if (line != kTrendColumns) throw std::runtime_error("line 2: unexpected columns");
+      continue;
+    }
+    if (line.empty()) continue;
+    // A crash mid-write cannot leave a short last row (files are replaced whole), so any
+    // malformed row means the file is not what it claims to be.
+    fields.clear();
+    std::size_t from = 0;
+    while (true) {
+      const std::size_t comma = line.find(',', from);
+      fields.push_back(line.substr(from, comma - from));
+      if (comma == std::string_view::npos) break;
+      from = comma + 1;
+    }
+    if (fields.size() != kTrendFields) {
+      throw std::runtime_error(
+          fmt::format("line {}: {} fields, expected {}", line_number, fields.size(), kTrendFields));
+    }
+    TrendPoint p;
+    double* numbers[] = {&p.unix_time,
+                         &p.index_p1,
+                         &p.index_p2,
+                         &p.score,
+                         &p.raise_threshold,
+                         &p.leak_lpm_per_mpa,
+                         &p.leak_lpm_per_mpa_ci95,
+                         &p.p1,
+                         &p.p2,
+                         &p.oil_temperature};
+    for (std::size_t k = 0; k < std::size(numbers); ++k) {
+      *numbers[k] = parse_number(fields[k], line_number, kNames[k]);
+    }
+    if (!std::isfinite(p.unix_time)) {
+      throw std::runtime_error(fmt::format("line {}, field unix_time: not finite", line_number));
+    }
+    p.alarm = parse_small(fields[10], line_number, kNames[10], 3);
+    p.learning = parse_small(fields[11], line_number, kNames[11], 1) == 1;
+    p.suspended = parse_small(fields[12], line_number, kNames[12], 1) == 1;
+    for (std::size_t k = 0; k < 3; ++k) {
+      p.channel_status[k] = parse_small(fields[13 + k], line_number, kNames[13 + k], 255);
+    }
+    if (!points.empty() && !(p.unix_time > points.back().unix_time)) {
+      throw std::runtime_error(
+          fmt::format("line {}, field unix_time: not after the previous row", line_number));
+    }
+    points.push_back(p);
+  }
+  if (line_number < 2) throw std::runtime_error("truncated: no header");
+  return points;
+}
 
 void read_loop_health(LoopHealth& out, const std::string& group, const LoopCounters& counters,
                       std::size_t ring_capacity, bool realtime) {
@@ -61,6 +199,19 @@ TrendHistory::TrendHistory(std::size_t capacity, const std::vector<std::string>&
   for (const auto& name : actuators) actuators_.push_back({name, FixedRing<TrendPoint>(capacity_)});
   groups_.reserve(groups.size());
   for (const auto& name : groups) groups_.push_back({name, FixedRing<LoopPoint>(capacity_)});
+}
+
+bool TrendHistory::restore(const std::string& actuator, const std::vector<TrendPoint>& points) {
+  for (auto& series : actuators_) {
+    if (series.name != actuator) continue;
+    const std::size_t skip = points.size() > capacity_ ? points.size() - capacity_ : 0;
+    FixedRing<TrendPoint> ring(capacity_);
+    for (std::size_t i = skip; i < points.size(); ++i) ring.push(points[i]);
+    for (std::size_t i = 0; i < series.points.size(); ++i) ring.push(series.points[i]);
+    series.points = std::move(ring);
+    return true;
+  }
+  return false;
 }
 
 const TrendHistory::ActuatorSeries* TrendHistory::actuator(const std::string& name) const {

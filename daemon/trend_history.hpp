@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "daemon/acquisition_loop.hpp"
@@ -118,6 +119,11 @@ class TrendHistory {
   const ActuatorSeries* actuator(const std::string& name) const;
   const GroupSeries* group(const std::string& name) const;
 
+  // Points of `actuator` kept from before a restart (decode_trend), oldest first: the newest
+  // `capacity` of them go into its ring ahead of anything recorded since. False when the
+  // configuration has no such actuator any more.
+  bool restore(const std::string& actuator, const std::vector<TrendPoint>& points);
+
   std::size_t capacity() const { return capacity_; }
   // The bytes the rings hold: capacity x (sizeof(TrendPoint) per actuator + sizeof(LoopPoint)
   // per group). What docs/daemon.md states.
@@ -129,6 +135,12 @@ class TrendHistory {
   std::vector<ActuatorSeries> actuators_;
   std::vector<GroupSeries> groups_;
 };
+
+// An actuator's trend as text, to survive a restart: a versioned first line, a header, then one
+// CSV row a point (NaN as "nan"). decode_trend() throws std::runtime_error naming the line and
+// the field of the first thing that is wrong (a newer version, a short row, a bad number).
+std::string encode_trend(const FixedRing<TrendPoint>& points);
+std::vector<TrendPoint> decode_trend(std::string_view text);
 
 // Trend points kept for `seconds` of history at one point every `interval_s` (at least 2).
 std::size_t trend_capacity(double seconds, double interval_s);

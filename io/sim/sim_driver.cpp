@@ -1,11 +1,12 @@
 #include "io/sim/sim_driver.hpp"
-#include "capture/units.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
+
+#include "capture/units.hpp"
 
 namespace leakmon::io {
 namespace {

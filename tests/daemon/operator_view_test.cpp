@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -22,6 +24,7 @@
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/support/paths.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -262,6 +265,117 @@ TEST(OperatorView, RecentEventsKeepTheNewestInOrder) {
   const std::string after = view.handle({"GET", "/api/events", "after=129"})->body;
   EXPECT_EQ(after.find("\"n128\""), std::string::npos);
   EXPECT_NE(after.find("\"n129\""), std::string::npos);
+}
+
+// A restart keeps what the page has seen: the trend survives as text, exactly (NaN too), and a
+// file that is not one is refused with the line and field named.
+TEST(TrendHistory, TrendTextRoundTripsAndBadFilesNameTheirFault) {
+  TrendHistory history(50, {"cyl"}, {"main"});
+  ViewSnapshot snapshot = snapshot_of("cyl", 0.25, AlarmState::active_unacknowledged);
+  snapshot.actuators[0].index_p1 = 21345.678912;
+  snapshot.actuators[0].oil_temperature = NAN;
+  for (int i = 0; i < 5; ++i) history.record(1.8e9 + i, snapshot);
+  const std::string text = encode_trend(history.actuator("cyl")->points);
+  const std::vector<TrendPoint> back = decode_trend(text);
+  ASSERT_EQ(back.size(), 5u);
+  EXPECT_DOUBLE_EQ(back[4].unix_time, 1.8e9 + 4);
+  EXPECT_DOUBLE_EQ(back[4].index_p1, 21345.678912);
+  EXPECT_DOUBLE_EQ(back[4].score, 0.25);
+  EXPECT_TRUE(std::isnan(back[4].oil_temperature));
+  EXPECT_EQ(back[4].alarm, static_cast<std::uint8_t>(AlarmState::active_unacknowledged));
+  EXPECT_EQ(back[4].channel_status[1], static_cast<std::uint8_t>(io::DeviceStatus::failure));
+  EXPECT_EQ(back[4].channel_status[2], TrendPoint::kNoChannel);
+
+  const auto error_of = [](const std::string& bad) -> std::string {
+    try {
+      decode_trend(bad);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  const std::size_t header_end = text.find('\n', text.find('\n') + 1) + 1;
+  const std::string header = text.substr(0, header_end);
+  const std::string row = text.substr(header_end, text.find('\n', header_end) + 1 - header_end);
+  EXPECT_NE(error_of("hello\n").find("line 1: not a leakmon trend file"), std::string::npos);
+  EXPECT_NE(error_of("# leakmon trend 2\n").find("format version 2"), std::string::npos);
+  EXPECT_NE(error_of(header + "1,2,3\n").find("line 3: 3 fields, expected 16"), std::string::npos);
+  std::string bad_number = row;
+  bad_number.replace(bad_number.find(','), 1, ",x");
+  EXPECT_NE(error_of(header + bad_number).find("line 3, field index_p1: 'x"), std::string::npos)
+      << error_of(header + bad_number);
+  EXPECT_NE(error_of(header + row + row).find("line 4, field unix_time: not after"),
+            std::string::npos);
+  std::string bad_alarm = row;
+  const std::size_t alarm_at = [&] {
+    std::size_t at = 0;
+    for (int k = 0; k < 10; ++k) at = bad_alarm.find(',', at) + 1;
+    return at;
+  }();
+  bad_alarm.replace(alarm_at, 1, "7");
+  EXPECT_NE(error_of(header + bad_alarm).find("field alarm: 7 is not an integer 0..3"),
+            std::string::npos)
+      << error_of(header + bad_alarm);
+  EXPECT_EQ(error_of(header), "(accepted)") << "an empty history is a valid one";
+}
+
+TEST(OperatorView, TrendAndEventsSurviveARestart) {
+  const std::string dir = test::scratch_dir("OperatorView.TrendAndEventsSurviveARestart");
+  const StateStore store(dir + "/state");
+  DaemonConfig config;
+  ActuatorConfig actuator;
+  actuator.name = "cyl 1";  // a name that is not a file name as it is
+  config.actuators.push_back(actuator);
+  config.metrics.trend_interval_s = 1.0;
+  config.metrics.trend_seconds = 100.0;
+  const double before_stop = 1.8e9 + 1000.0;
+  {
+    OperatorView view(config, {"main"});
+    ViewSnapshot source = snapshot_of("cyl 1", 0.5, AlarmState::normal);
+    int i = 0;
+    view.set_source([&](ViewSnapshot& out) {
+      source.actuators[0].score = 0.01 * i;
+      out = source;
+    });
+    for (; i < 150; ++i) view.sample(before_stop - 149 + i);  // keeps the newest 100
+    view.save_history(store);
+  }
+  ASSERT_TRUE(std::filesystem::exists(store.trend_file_of("cyl 1")));
+
+  std::ofstream(dir + "/events.jsonl")
+      << "{\"event\": \"daemon_started\", \"version\": \"0.1.0\"}\n"
+      << "{\"t\": 12.5, \"event\": \"alarm_raised\", \"actuator\": \"cyl 1\"}\n"
+      << "not json\n"
+      << "{\"event\": \"daemon_stopped\", \"reas";  // a crash mid-line
+
+  // Restarted 30 s later: points older than the history's 100 s are dropped, a gap point
+  // breaks the line over the downtime, and the page's events start with the log's.
+  OperatorView view(config, {"main"});
+  EXPECT_TRUE(view.restore_history(store, before_stop + 30.0).empty());
+  EXPECT_EQ(view.restore_events(dir + "/events.jsonl"), 2u);
+  view.set_source([](ViewSnapshot& out) { out = snapshot_of("cyl 1", 0.125, AlarmState::normal); });
+  view.sample(before_stop + 30.0);
+  const std::string trend = view.trend_json(0.0);
+  EXPECT_NE(trend.find(fmt::format("\"time\":[{:.3f},", before_stop - 70)), std::string::npos)
+      << trend.substr(0, 300);
+  EXPECT_NE(trend.find(fmt::format("{:.3f},{:.3f},{:.3f}]", before_stop, before_stop + 1,
+                                   before_stop + 30)),
+            std::string::npos)
+      << "the newest point, the gap, the first after the restart";
+  EXPECT_NE(trend.find("\"score\":[0.79,"), std::string::npos) << "oldest kept: i = 79";
+  EXPECT_NE(trend.find("1.49,null,0.125]"), std::string::npos) << "newest, gap, restarted";
+  const std::string events = view.handle({"GET", "/api/events", ""})->body;
+  EXPECT_EQ(events.rfind("{\"next\":3,", 0), 0u) << events;
+  EXPECT_NE(events.find("\"alarm_raised\""), std::string::npos);
+  EXPECT_EQ(events.find("daemon_stopped"), std::string::npos) << "the torn line is skipped";
+
+  // A file that is not a trend is set aside with a warning naming it, never half-read.
+  std::ofstream(store.trend_file_of("cyl 1")) << "# leakmon trend 1\ngarbage\n";
+  OperatorView fresh(config, {"main"});
+  const auto warnings = fresh.restore_history(store, before_stop + 30.0);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(store.trend_file_of("cyl 1").string()), std::string::npos);
+  EXPECT_NE(warnings[0].find("line 2: unexpected columns"), std::string::npos) << warnings[0];
 }
 
 TEST(OperatorView, AckNeedsTheConfiguredToken) {

@@ -6,6 +6,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -46,6 +47,7 @@ void write_capture(const std::string& dir, std::uint64_t seed, double seconds) {
 
 struct DaemonRun {
   std::string log, events, learning_metric;
+  std::string trend;  // the first /api/trend answer that held the actuator
   int exit_code = -1;
 };
 
@@ -63,6 +65,16 @@ DaemonRun run_daemon(const std::string& dir, int port, const std::string& name) 
           if (pos == std::string::npos) return false;
           run.learning_metric = body.substr(pos, body.find('\n', pos) - pos);
           return true;
+        } catch (const std::exception&) {
+          return false;
+        }
+      },
+      10s);
+  test::eventually(
+      [&] {
+        try {
+          run.trend = http_request("127.0.0.1", port, "GET", "/api/trend").body;
+          return run.trend.find("\"name\":\"cyl\"") != std::string::npos;
         } catch (const std::exception&) {
           return false;
         }
@@ -97,6 +109,14 @@ TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
   EXPECT_NE(shown.find("(learned)"), std::string::npos) << shown;
   EXPECT_NE(shown.find("fits the configuration"), std::string::npos) << shown;
   const std::string saved = test::DaemonProcess::read_file(file.string());
+  // The live page's trend is kept beside the state: its first point comes back after the
+  // restart, before the points of the new run.
+  const std::string trend_file = test::DaemonProcess::read_file(dir + "/state/cyl.trend.csv");
+  ASSERT_EQ(trend_file.rfind("# leakmon trend 1\n", 0), 0u) << trend_file.substr(0, 200);
+  const std::size_t first_row = trend_file.find('\n', trend_file.find('\n') + 1) + 1;
+  const std::string first_time =
+      trend_file.substr(first_row, trend_file.find(',', first_row) - first_row);
+  EXPECT_GT(std::count(trend_file.begin(), trend_file.end(), '\n'), 10) << trend_file;
 
   // Restart: resumes, not learning from its first hop on (learning would need 21 s of 3).
   write_capture(dir, 32, 3.0);
@@ -107,6 +127,8 @@ TEST(DaemonStateProcess, RestartKeepsLearningAndBadStateStartsFresh) {
   EXPECT_NE(second.learning_metric.find("} 0"), std::string::npos) << second.learning_metric;
   EXPECT_EQ(second.events.find("alarm_raised"), std::string::npos) << second.events;
   EXPECT_NE(show(dir).find("(learned)"), std::string::npos);
+  EXPECT_NE(second.trend.find("\"time\":[" + first_time + ","), std::string::npos)
+      << first_time << " in " << second.trend.substr(0, 400);
 
   // A corrupt (truncated) file: one warning, then a fresh learning phase.
   std::ofstream(file, std::ios::trunc) << saved.substr(0, saved.size() / 2);
