@@ -249,11 +249,12 @@ void Daemon::start() {
   }
   started_ns_ = monotonic_now_ns();
   last_state_save_ns_ = started_ns_;
+  last_trend_save_ns_ = started_ns_;
 }
 
-void Daemon::save_state() {
+void Daemon::save_state(bool with_trend) {
   if (!state_store_ || !worker_) return;
-  if (operator_view_) {
+  if (operator_view_ && with_trend) {
     try {
       operator_view_->save_history(*state_store_);
     } catch (const std::exception& e) {
@@ -286,7 +287,7 @@ void Daemon::stop() {
   stop_worker_.store(true, std::memory_order_release);
   if (worker_thread_.joinable()) worker_thread_.join();
   worker_->drain(monotonic_now_ns());  // whatever the loops pushed last
-  save_state();
+  save_state(true);
   {
     // The last event: everything the loops, the worker and the state saving had to say is
     // published before it, and the sinks are flushed after it.
@@ -349,8 +350,11 @@ bool Daemon::making_progress(std::int64_t now_ns) {
 void Daemon::housekeeping(std::int64_t now_ns) {
   if (state_store_ &&
       now_ns - last_state_save_ns_ >= static_cast<std::int64_t>(config_.state.save_seconds * 1e9)) {
-    save_state();
+    const bool with_trend =
+        now_ns - last_trend_save_ns_ >= static_cast<std::int64_t>(kTrendSaveSeconds * 1e9);
+    save_state(with_trend);
     last_state_save_ns_ = now_ns;
+    if (with_trend) last_trend_save_ns_ = now_ns;
   }
   // Overruns: at most one warning (and one event) per second for all groups.
   if (now_ns - last_overrun_warning_ns_ >= kSecond) {

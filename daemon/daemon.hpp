@@ -74,7 +74,9 @@ class Daemon {
   void housekeeping(std::int64_t now_ns);
   // Writes every actuator's learned state to the state directory (main thread; the worker is
   // locked only for the snapshot, the files are written outside it).
-  void save_state();
+  // The learned state; the page's trend too when `with_trend` (it is megabytes: written every
+  // kTrendSaveSeconds and at shutdown, not with every state save).
+  void save_state(bool with_trend);
   // By actuator, when its learned state in the state directory was saved (for the metrics).
   std::map<std::string, double> state_saved_unix() const;
   bool making_progress(std::int64_t now_ns);
@@ -99,6 +101,8 @@ class Daemon {
   std::unique_ptr<HttpEndpoint> endpoint_;
   std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;
+  std::int64_t last_trend_save_ns_ = 0;
+  static constexpr double kTrendSaveSeconds = 600.0;
   mutable std::mutex state_saved_mutex_;  // the main thread saves, the metrics thread reads
   std::map<std::string, double> state_saved_unix_;
   CpuLatencyRequest cpu_latency_;

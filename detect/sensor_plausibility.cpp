@@ -138,7 +138,12 @@ SensorFault SensorPlausibility::condition() const {
   if (band_run_ >= limits_.saturated_run) return SensorFault::saturated;
   // Exact repeats at a range end are saturation (above), not a stalled converter.
   if (limits_.frozen_run > 0 && repeat_run_ >= limits_.frozen_run && band_run_ == 0) {
-    return SensorFault::frozen;
+    // Where no range end is configured (a position transducer), a constant reached by a leap
+    // no position can make is the converter pinned at a limit, or with exactly 0 a lost
+    // signal; a stalled converter holds the value the signal had.
+    const bool range_known = std::isfinite(spec_.min) && std::isfinite(spec_.max);
+    if (range_known || !run_began_with_jump_) return SensorFault::frozen;
+    return last_value_ == 0.0 ? SensorFault::dropout : SensorFault::saturated;
   }
   if (last_spike_ != 0 && samples_ - last_spike_ <= limits_.spike_quiet) {
     return SensorFault::spikes;
@@ -163,6 +168,18 @@ double SensorPlausibility::push(double value) noexcept {
     zero_run_ = 0;
   } else {
     nan_run_ = 0;
+    if (value != last_value_) {
+      // The same test as for a spike (below), on the newest value against the four before it.
+      double low = last_value_, high = last_value_;
+      for (std::size_t k = 2; k <= 2 * kDelay + 1; ++k) {
+        const double before = history_[(next_ + n - k) % n];
+        low = std::min(low, before);
+        high = std::max(high, before);
+      }
+      run_began_with_jump_ =
+          std::isfinite(low) && std::isfinite(high) &&
+          std::abs(value - last_value_) > limits_.spike_sigma + 2.0 * (high - low);
+    }
     repeat_run_ = value == last_value_ ? repeat_run_ + 1 : 1;
     const bool in_band =
         value <= spec_.min + 1.5 * spec_.resolution || value >= spec_.max - 1.5 * spec_.resolution;

@@ -92,9 +92,10 @@ class SensorPlausibility {
   std::uint64_t samples_ = 0;
 
   double last_value_ = std::numeric_limits<double>::quiet_NaN();
-  std::uint32_t repeat_run_ = 0;  // samples in the current run of one exact value
-  std::uint32_t band_run_ = 0;    // consecutive samples within one LSB of a range end
-  std::uint32_t zero_run_ = 0;    // consecutive exact zeros (when zero_is_dropout)
+  std::uint32_t repeat_run_ = 0;      // samples in the current run of one exact value
+  bool run_began_with_jump_ = false;  // that run's first value leapt off the stream before it
+  std::uint32_t band_run_ = 0;        // consecutive samples within one LSB of a range end
+  std::uint32_t zero_run_ = 0;        // consecutive exact zeros (when zero_is_dropout)
   std::uint32_t nan_run_ = 0;
   std::uint64_t last_spike_ = 0;  // sample number of the last rejected spike; 0: none
   std::uint64_t spikes_rejected_ = 0;

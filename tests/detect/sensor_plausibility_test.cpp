@@ -179,6 +179,20 @@ std::vector<Corruption> corruptions() {
       {"p1 dropout to NaN", "p1", SensorFault::dropout, [](std::vector<double>& v, std::size_t k) {
          for (std::size_t i = k; i < v.size(); ++i) v[i] = kNaN;
        }});
+  // No range end is configured for x: a reading that leaps to a constant is pinned at a limit,
+  // one that stays where it was is stalled (above).
+  list.push_back({"x saturated at +L/2", "x", SensorFault::saturated,
+                  [](std::vector<double>& v, std::size_t k) {
+                    for (std::size_t i = k; i < v.size(); ++i) v[i] = 0.305;
+                  }});
+  list.push_back({"x saturated at -L/2", "x", SensorFault::saturated,
+                  [](std::vector<double>& v, std::size_t k) {
+                    for (std::size_t i = k; i < v.size(); ++i) v[i] = -0.305;
+                  }});
+  list.push_back(
+      {"x dropout to zeros", "x", SensorFault::dropout, [](std::vector<double>& v, std::size_t k) {
+         for (std::size_t i = k; i < v.size(); ++i) v[i] = 0.0;
+       }});
   list.push_back(
       {"x dropout to NaN", "x", SensorFault::dropout, [](std::vector<double>& v, std::size_t k) {
          for (std::size_t i = k; i < v.size(); ++i) v[i] = kNaN;
@@ -357,7 +371,8 @@ TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
     const std::vector<SensorFault> kinds =
         pressure ? std::vector{SensorFault::frozen, SensorFault::saturated, SensorFault::spikes,
                                SensorFault::dropout}
-                 : std::vector{SensorFault::frozen, SensorFault::spikes, SensorFault::dropout};
+                 : std::vector{SensorFault::frozen, SensorFault::saturated, SensorFault::spikes,
+                               SensorFault::dropout};
     const SensorFault kind = kinds[random() % kinds.size()];
     const double onset_s = std::uniform_real_distribution<double>(10.0, 30.0)(random);
     capture::Capture capture = healthy(ft ? "healthy-ft" : "healthy", random() % 1000000, 60.0);
@@ -372,7 +387,8 @@ TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
       case SensorFault::saturated:
         for (std::size_t i = onset; i < v.size(); ++i) {
           v[i] =
-              variant == 0
+              !pressure ? (variant == 0 ? 0.305 : -0.305)
+              : variant == 0
                   ? 4095.0 * lsb()
                   : std::clamp(
                         std::nearbyint(std::normal_distribution<double>(-2e3, 5e3)(random) / lsb()),
@@ -381,7 +397,7 @@ TEST(SensorPlausibility, RandomFaultsNamedWithinFiveSeconds) {
         }
         break;
       case SensorFault::dropout:
-        for (std::size_t i = onset; i < v.size(); ++i) v[i] = variant == 0 && pressure ? 0.0 : kNaN;
+        for (std::size_t i = onset; i < v.size(); ++i) v[i] = variant == 0 ? 0.0 : kNaN;
         break;
       case SensorFault::spikes: {
         // 3 a minute at uniformly random places, +-1..4 MPa (x: +-2..8 mm).
