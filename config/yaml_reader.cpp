@@ -155,6 +155,51 @@ void reject_duplicate_keys(const std::string& text, const std::string& source_na
   }
 }
 
+// YAML::Load reads the first document and silently drops the rest: two configurations pasted
+// into one file would run the first. A marker line ("---" or "..." at column 0, which YAML
+// allows nowhere else) after content starts a second document. Found on the text, because
+// walking yaml-cpp's further documents can loop on malformed input.
+static void reject_further_documents(const std::string& text, const std::string& source_name) {
+  bool content = false;
+  bool ended = false;
+  std::size_t line_number = 0;
+  for (std::size_t from = 0; from <= text.size();) {
+    const std::size_t end = std::min(text.find('\n', from), text.size());
+    std::string_view line(text.data() + from, end - from);
+    from = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const auto marker = [&](std::string_view m) {
+      return line.substr(0, 3) == m && (line.size() == 3 || line[3] == ' ' || line[3] == '\t');
+    };
+    if (marker("---") || marker("...")) {
+      if (content && marker("---")) {
+        throw ConfigError(
+            fmt::format("{}:{}:1: a second YAML document ('---'); a configuration is one document "
+                        "(only the first would take effect)",
+                        source_name, line_number));
+      }
+      if (marker("...")) ended = content;
+      const std::string_view rest = line.substr(3);
+      if (marker("---") && rest.find_first_not_of(" \t") != std::string_view::npos &&
+          rest[rest.find_first_not_of(" \t")] != '#') {
+        content = true;  // "--- value": the document's content starts on the marker line
+      }
+      continue;
+    }
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos || line[first] == '#') continue;
+    if (line[0] == '%' && !content) continue;  // a directive before the document
+    if (ended) {
+      throw ConfigError(fmt::format(
+          "{}:{}:{}: content after the end of the YAML document ('...'); a configuration is "
+          "one document",
+          source_name, line_number, first + 1));
+    }
+    content = true;
+  }
+}
+
 ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source, std::string path)
     : node_(std::move(node)), source_(std::move(source)), path_(std::move(path)) {}
 
@@ -177,6 +222,7 @@ ConfigNode ConfigNode::load_string(const std::string& text, const std::string& s
   try {
     YAML::Node root = YAML::Load(text);
     reject_duplicate_keys(text, source_name);
+    reject_further_documents(text, source_name);
     if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     return ConfigNode(root, source, "");
   } catch (const YAML::Exception& e) {

@@ -98,6 +98,26 @@ TEST(ConfigNode, DuplicateKeysAreErrorsAtTheSecondOccurrence) {
             "no error");
 }
 
+// Two configurations pasted into one file: yaml-cpp would read the first and drop the rest.
+TEST(ConfigNode, ASecondDocumentIsAnErrorNotIgnored) {
+  EXPECT_EQ(error_of([] { ConfigNode::load_string("a: 1\n---\na: 2\n", "f.yaml"); }),
+            "f.yaml:2:1: a second YAML document ('---'); a configuration is one document (only "
+            "the first would take effect)");
+  EXPECT_EQ(error_of([] { ConfigNode::load_string("a: 1\n...\nb: 2\n", "f.yaml"); }),
+            "f.yaml:3:1: content after the end of the YAML document ('...'); a configuration is "
+            "one document");
+  // One document, however it is marked: a leading '---', a directive, comments, a closing
+  // '...', a '---' inside a value's text (not at column 0).
+  for (const char* one : {"---\na: 1\n", "%YAML 1.2\n---\na: 1\n...\n", "# c\n---  # c\na: 1\n",
+                          "a: |\n  ---\n  x\n", "a: 1\n...\n# the end\n", "a: '--- x'\n"}) {
+    EXPECT_EQ(error_of([&] { ConfigNode::load_string(one, "f.yaml"); }), "no error") << one;
+  }
+  EXPECT_NE(error_of([] {
+              ConfigNode::load_string("a: 1\r\n---\r\nb: 2\r\n", "f.yaml");
+            }).find("f.yaml:2:1: a second YAML document"),
+            std::string::npos);
+}
+
 // Found by fuzz/config_reader_fuzz.cpp: a list as a key escaped as a yaml-cpp exception, and a
 // malformed stream made the parser report documents without end.
 TEST(ConfigNode, FuzzFindingsStayConfigErrors) {
