@@ -108,12 +108,14 @@ void DetailXcorrDetector::resume_after_gap() {
 double DetailXcorrDetector::feature() const {
   if (hops_filled_ < options_.window_hops) return kMissing;
   HopSums total;
+  // Oldest first, so that an imported state (stored oldest first) sums in the same order.
   for (std::size_t i = 0; i < options_.window_hops; ++i) {
-    total.aa += hops_[i].aa;
-    total.bb += hops_[i].bb;
-    total.ab += hops_[i].ab;
-    total.e1 += hops_[i].e1;
-    total.e3 += hops_[i].e3;
+    const HopSums& h = hops_[(hop_next_ + i) % options_.window_hops];
+    total.aa += h.aa;
+    total.bb += h.bb;
+    total.ab += h.ab;
+    total.e1 += h.e1;
+    total.e3 += h.e3;
   }
   if (correlation_) {
     if (!(total.aa > 0.0 && total.bb > 0.0)) return kMissing;

@@ -22,6 +22,7 @@ std::vector<Candidate> candidates() {
       // ratio against d1 and d3.
       {"detail_xcorr", "detail_xcorr", true, false, false, cusum_grid, 1.0, 0.0, 0.5},
       {"detail_xcorr_p1", "detail_xcorr", false, false, false, cusum_grid, 1.0, 0.0, 0.5},
+      {"detail_xcorr_temp", "detail_xcorr", true, false, false, cusum_grid, 1.0, 0.0, 0.5, true},
   };
 }
 
