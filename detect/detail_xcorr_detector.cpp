@@ -180,6 +180,11 @@ Decision DetailXcorrDetector::update(const Observation& observation) {
   const double index = std::isnan(value) ? kMissing : std::exp(oriented);
   inner.index_p1 = index;
   inner.index_p2 = index;
+  // The correlation hardly moves with the oil (about 1/30 of its block spread per kelvin) and the
+  // drift reference follows what does. With `temp` the test would fit a temperature coefficient
+  // on what learning saw and stop following the slope: in warm-ups that learned on the steepest
+  // warming that raised false alarms (2 in 0.9 h, docs/detection.md). So `temp` is not used.
+  inner.temp = kMissing;
   Decision decision = test_.update(inner);
   // For the operator: the paper's index of the chamber, not the feature's scale.
   decision.index = use_p2_alone_ ? observation.index_p2 : observation.index_p1;

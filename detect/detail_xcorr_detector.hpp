@@ -15,7 +15,7 @@
 // run on exp(-correlation) (resp. exp(band ratio)) as its "index": the per-rig regression on the
 // load and the activity, the drift reference, the supply-step handling and the threshold from
 // the target false-alarm rate carry over; the feature's own scale replaces the index's physics
-// (no supply exponent, no temperature prior).
+// (no supply exponent; the oil temperature is not used, the drift reference follows it).
 #pragma once
 
 #include <array>
