@@ -2,6 +2,7 @@
 // antiphase plus independent transducer noise; a leak damps the mode.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "detect/detector.hpp"
@@ -40,7 +41,7 @@ struct SyntheticPressures {
       load = (uniform(random) - 0.5) * 4e6;
     }
     const double radius = t >= onset ? leak_pole_radius : pole_radius;
-    const double a1 = 2.0 * radius * std::cos(2.0 * M_PI * mode_hz / rate);
+    const double a1 = 2.0 * radius * std::cos(2.0 * std::numbers::pi * mode_hz / rate);
     const double a2 = -radius * radius;
     const double ps = t >= supply_step_at ? supply_after : supply;
     double sum1 = 0.0, sum2 = 0.0;
