@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -43,6 +44,8 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       detector_(build_detector(config, layout, period_ns)),
       alarm_(effective(config.alarm)),
       fingerprint_(state_fingerprint(config, period_ns)),
+      hop_samples_p1_(config.features.step, kNaN),
+      hop_samples_p2_(config.features.step, kNaN),
       activity_(config.features.window, kNaN),
       index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
       sample_rate_hz_(1e9 / static_cast<double>(period_ns)),
@@ -164,6 +167,10 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   hop_p2_.add(p2);
   hop_ps_.add(unchecked.ps);
   hop_temp_.add(unchecked.temp);
+  if (hop_samples_ < hop_samples_p1_.size()) {
+    hop_samples_p1_[hop_samples_] = p1;
+    hop_samples_p2_[hop_samples_] = p2;
+  }
   ++hop_samples_;
 
   activity_[activity_next_] = layout_.xref >= 0 ? unchecked.xref : x;
@@ -232,6 +239,9 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   observation.p2 = mean(hop_p2_, layout_.p2);
   observation.ps = mean(hop_ps_, layout_.ps);
   observation.temp = mean(hop_temp_, layout_.temp);
+  const std::size_t kept = std::min(hop_samples_, hop_samples_p1_.size());
+  if (layout_.p1 >= 0) observation.p1_samples = {hop_samples_p1_.data(), kept};
+  if (layout_.p2 >= 0) observation.p2_samples = {hop_samples_p2_.data(), kept};
   if ((layout_.xref >= 0 || layout_.x >= 0) && activity_filled_ == activity_.size()) {
     double sum = 0.0;
     for (double v : activity_) sum += v;

@@ -147,6 +147,8 @@ class ActuatorMonitor {
   };
   HopMean hop_u_, hop_x_, hop_p1_, hop_p2_, hop_ps_, hop_temp_;
   std::size_t hop_samples_ = 0;
+  // The hop's cleaned chamber pressures (Observation::p1_samples), `step` long.
+  std::vector<double> hop_samples_p1_, hop_samples_p2_;
   // Ring of the excitation signal (xref, else x) over the window, for Observation::x_activity.
   std::vector<double> activity_;
   std::size_t activity_next_ = 0;

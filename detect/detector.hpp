@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -31,6 +32,10 @@ struct Observation {
   // Standard deviation of the position reference or position over the window, when known: the
   // excitation that produced the index.
   double x_activity = kMissing;
+  // The hop's chamber pressure samples themselves (the `step` samples the hop means average,
+  // oldest first, NaN where one was missing; empty when the chamber is not acquired), for
+  // detectors that compute their own features. Valid only during the update() call.
+  std::span<const double> p1_samples, p2_samples;
 };
 
 struct Decision {

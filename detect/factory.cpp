@@ -9,6 +9,7 @@
 #include <string_view>
 #include <utility>
 
+#include "detect/detail_xcorr_detector.hpp"
 #include "detect/flow_balance_detector.hpp"
 #include "detect/fused_detector.hpp"
 #include "detect/index_cusum_detector.hpp"
@@ -69,6 +70,12 @@ constexpr std::string_view kFlowKeysData[] = {"supply_pressure",
                                               "oil_viscosity_100"};
 constexpr std::string_view kPaperKeysData[] = {"baseline_quantile", "window_seconds",
                                                "raise_fraction", "clear_fraction", "channel"};
+constexpr std::string_view kXcorrKeysData[] = {
+    "design_shift",         "min_shift",     "false_alarms_per_hour", "block_seconds",
+    "supply_pressure",      "tank_pressure", "drift_guard_seconds",   "drift_window_seconds",
+    "supply_settle_seconds"};
+constexpr KeyList kXcorrKeys = kXcorrKeysData;
+constexpr double kXcorrBlockSeconds = 1.6;
 constexpr KeyList kLearningKeys = kLearningKeysData, kIndexKeys = kIndexKeysData,
                   kFlowKeys = kFlowKeysData, kPaperKeys = kPaperKeysData;
 
@@ -183,6 +190,26 @@ PaperBaselineOptions paper_options(const config::ConfigNode* options, const Avai
   return o;
 }
 
+// design_shift / min_shift are in the feature's units: correlation with both chambers, ln of
+// the band ratio with one (detail_xcorr_detector.hpp).
+DetailXcorrOptions xcorr_options(const config::ConfigNode* options, const AvailableSignals& s) {
+  DetailXcorrOptions o;
+  o.test = index_options(options, s, 1.0);
+  // Two windows per block: the sliding feature's neighbouring blocks then share little data.
+  o.test.block_seconds = kXcorrBlockSeconds;
+  read(options, "block_seconds", o.test.block_seconds, 0.01, 60.0);
+  const bool correlation = s.p1 && s.p2;
+  double& design = correlation ? o.design_shift_correlation : o.design_shift_ratio;
+  double& floor = correlation ? o.min_shift_correlation : o.min_shift_ratio;
+  read(options, "design_shift", design, 1e-5, 2.0);
+  read(options, "min_shift", floor, 0.0, 2.0);
+  if (options != nullptr && floor >= design) {
+    const auto at = options->find("min_shift");
+    (at ? *at : options->at("design_shift")).fail("min_shift must be below design_shift");
+  }
+  return o;
+}
+
 void require(bool ok, const std::string& kind, const char* what) {
   if (!ok) throw std::invalid_argument("detector '" + kind + "' needs " + what);
 }
@@ -190,7 +217,7 @@ void require(bool ok, const std::string& kind, const char* what) {
 }  // namespace
 
 std::vector<std::string> detector_kinds() {
-  return {"default", "paper", "index_cusum", "flow_balance", "fused"};
+  return {"default", "paper", "index_cusum", "flow_balance", "fused", "detail_xcorr"};
 }
 
 // Chosen by `leakmon evaluate` (docs/detection.md): with u and x the flow balance alone detects
@@ -213,6 +240,11 @@ std::unique_ptr<Detector> make_detector(const std::string& kind, const Available
     require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
     expect_keys(options, {kLearningKeys, kIndexKeys});
     return std::make_unique<IndexCusumDetector>(index_options(options, signals, 1.0), hop_seconds);
+  }
+  if (resolved == "detail_xcorr") {
+    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
+    expect_keys(options, {kLearningKeys, kXcorrKeys});
+    return std::make_unique<DetailXcorrDetector>(xcorr_options(options, signals), hop_seconds);
   }
   if (resolved == "flow_balance") {
     require(has_all(signals), kind, "p1, p2, u and x");

@@ -32,8 +32,6 @@ constexpr double kSupplyStep = 0.02;
 constexpr std::size_t kSupplyStepHops = 10;
 constexpr double kSupplyTransientSeconds = 3.0;
 constexpr double kSupplyMemorySeconds = 2.0;
-// The spool noise's flow, Kv w sqrt(dp), scales with the root of the valve's pressure drop.
-constexpr double kSupplyExponent = 0.5;
 // The drift trend needs this many blocks in its reference window to fit a slope; with fewer
 // (but at least kTrendLevelBlocks) it uses their level.
 constexpr std::size_t kTrendSlopeBlocks = 20;
@@ -142,7 +140,7 @@ double IndexCusumDetector::supply_for(const Observation& o, double load) {
 double IndexCusumDetector::expected_log_index(const Block& b) const {
   return coefficients_[0] + coefficients_[1] * b.load + coefficients_[2] * b.load_squared +
          coefficients_[3] * b.log_activity + coefficients_[4] * b.log_friction +
-         kSupplyExponent * b.log_supply;
+         options_.supply_exponent * b.log_supply;
 }
 
 // Adds one hop; true when a block completed with enough valid hops (then `completed` holds it).
@@ -185,9 +183,10 @@ bool IndexCusumDetector::add_to_block(const Observation& o, double log_index, do
 void IndexCusumDetector::finish_learning() {
   learned_model_ = true;
   if (learned_.size() < 2 * kRegressors) return;  // too little data: never judges
-  // The supply's share is physical (kSupplyExponent), not learned: the learning period rarely
+  // The supply's share is physical (supply_exponent), not learned: the learning period rarely
   // sees more than one supply.
-  auto response = [](const Block& b) { return b.log_index - kSupplyExponent * b.log_supply; };
+  const double exponent = options_.supply_exponent;
+  auto response = [exponent](const Block& b) { return b.log_index - exponent * b.log_supply; };
   // First without the temperature: the spread that weighs the prior.
   LeastSquares<4> plain;
   for (const auto& b : learned_) {

@@ -59,6 +59,9 @@ struct IndexCusumOptions {
   double drift_window_seconds = 240.0;
   // After a supply step: no judging for this long while the reference re-anchors.
   double supply_settle_seconds = 20.0;
+  // d ln(index) / d ln(ps): the spool noise's flow, Kv w sqrt(dp), scales with the root of the
+  // valve's pressure drop. 0 for a feature that does not scale with the supply (a ratio).
+  double supply_exponent = 0.5;
 };
 
 class IndexCusumDetector final : public Detector {

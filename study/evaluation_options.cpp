@@ -18,6 +18,11 @@ std::vector<Candidate> candidates() {
       // The daemon's default with an oil temperature transducer too (drifting conditions).
       {"default_temp", "default", true, true, true, cusum_grid, 1.0, 0.0, 0.5, true},
       {"index_cusum_temp", "index_cusum", true, false, false, cusum_grid, 1.0, 0.0, 0.5, true},
+      // Pressure only (issue 13): level-2 detail correlation of p1 and p2; p1 alone: its band
+      // ratio against d1 and d3.
+      {"detail_xcorr", "detail_xcorr", true, false, false, cusum_grid, 1.0, 0.0, 0.5},
+      {"detail_xcorr_p1", "detail_xcorr", false, false, false, cusum_grid, 1.0, 0.0, 0.5},
+      {"detail_xcorr_temp", "detail_xcorr", true, false, false, cusum_grid, 1.0, 0.0, 0.5, true},
   };
 }
 

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Markdown tables for docs/detection.md from `leakmon evaluate` directories.
 Usage: detection_tables.py EVAL_DIR              (main tables of one evaluation)
-       detection_tables.py --effects DIR [DIR...] (one row per directory: the effect runs)"""
+       detection_tables.py --effects DIR [DIR...] (one row per directory: the effect runs)
+       detection_tables.py --pressure-only EVAL_DIR (issue 13: every detector without u and x,
+                                                    per controller, at 5e-13, 1e-12, 2e-12)"""
 import json
 import os
 import sys
@@ -76,8 +78,33 @@ def effects_table(directories, names=("flow_balance", "index_cusum")):
                 cell(by_size.get(1e-12))))
 
 
+# Candidates that need u and x; every other one reads the chamber pressures only.
+NEEDS_VALVE_AND_POSITION = {"flow_balance", "fused", "default", "default_temp"}
+
+
+def chambers(name):
+    return "p1" if name == "paper" or name.endswith("_p1") else "p1, p2"
+
+
+def pressure_only_table(directory):
+    detectors = [d for d in load(directory)["detectors"]
+                 if d["name"] not in NEEDS_VALVE_AND_POSITION]
+    sizes = (5e-13, 1e-12, 2e-12)
+    print("| detector | chambers | controller | false alarms / h (count in healthy h; 95 % upper "
+          "bound) | " + " | ".join("%.0e" % s for s in sizes) + " |")
+    print("|---" * (len(sizes) + 4) + "|")
+    for d in sorted(detectors, key=lambda d: (chambers(d["name"]) == "p1", d["name"])):
+        for ctrl in ("all", "basic", "fault_tolerant"):
+            healthy, by_size = design_rows(d, ctrl)
+            print("| %s | %s | %s | %s | %s |" % (
+                d["name"], chambers(d["name"]), ctrl, false_alarms(healthy),
+                " | ".join(cell(by_size.get(s)) for s in sizes)))
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "--effects":
         effects_table(sys.argv[2:])
+    elif sys.argv[1] == "--pressure-only":
+        pressure_only_table(sys.argv[2])
     else:
         main_tables(sys.argv[1])

@@ -6,6 +6,7 @@
 
 #include "detect/factory.hpp"
 #include "detect/fused_detector.hpp"
+#include "tests/detect/synthetic_pressures.hpp"
 #include "tests/detect/synthetic_rig.hpp"
 #include "tests/support/alloc_counter.hpp"
 
@@ -166,6 +167,34 @@ TEST(Detectors, UpdateAllocatesNothingAfterConstruction) {
       allocations += scope.count();
     }
     EXPECT_EQ(allocations, 0u) << kind;
+  }
+}
+
+// Detectors that compute their own features from the hop's pressure samples: the filters, the
+// window and the test run on every hop, through learning, detection and the alarm.
+TEST(Detectors, UpdateWithPressureSamplesAllocatesNothing) {
+  for (const auto& kind : detector_kinds()) {
+    for (const auto& signals : {kPressuresOnly, AvailableSignals{true, false, false, false}}) {
+      if (kind == "flow_balance" || kind == "fused") continue;  // need u and x
+      auto detector = make_detector(kind, signals, 0.04, nullptr);
+      test::SyntheticPressures rig;
+      rig.onset = 150.0;
+      rig.leak_pole_radius = 0.9;
+      std::uint64_t allocations = 0;
+      bool judged = false;
+      for (int i = 0; i < 6000; ++i) {
+        Observation o = rig.next();
+        if (!signals.p2) o.p2_samples = {};
+        test::AllocationScope scope;
+        const Decision d = detector->update(o);
+        allocations += scope.count();
+        judged |= !std::isnan(d.score);
+      }
+      EXPECT_EQ(allocations, 0u) << kind;
+      if (kind == "detail_xcorr") {
+        EXPECT_TRUE(judged);
+      }
+    }
   }
 }
 
