@@ -69,8 +69,9 @@ TEST(HiddenEffect, EveryEffectOfTheLibraryIsFoundOrAtWorstMissed) {
     std::printf("  %-17s -> %-17s param %s (true %.4g, estimate %.4g)  nrmse %.4f -> %.4f\n",
                 o.truth.c_str(), o.named.c_str(), o.parameter_ok ? "ok " : "BAD", o.true_value,
                 o.estimate, o.nrmse_before, o.nrmse_after);
-    // A wrong cause sends the engineer after the wrong part: never acceptable.
-    EXPECT_TRUE(o.named == effect || o.named == "none")
+    // A wrong cause sends the engineer after the wrong part: never acceptable. A miss is
+    // `none`, or `unexplained` (issue 12) when the nominal model stays above the noise floor.
+    EXPECT_TRUE(o.named == effect || o.named == "none" || o.named == "unexplained")
         << effect << " was named " << o.named << " (seed " << o.seed << ")";
     if (o.named == effect) {
       EXPECT_LT(o.nrmse_after, o.nrmse_before) << effect << " seed " << o.seed;
