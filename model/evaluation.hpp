@@ -60,7 +60,9 @@ std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::
 struct EvaluationSummary {
   std::vector<CaseOutcome> cases;
   std::string markdown() const;       // accuracy figures and the confusion matrix
-  std::string kind_markdown() const;  // issue 12's targets per class
+  std::string kind_markdown() const;  // issue 12's classes, one line each
+  // Issue 12's targets one by one (a line each), with counts, over the classes drawn.
+  std::string targets_markdown() const;
   std::string csv() const;            // one line per case
 };
 
