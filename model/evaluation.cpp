@@ -275,8 +275,7 @@ std::string EvaluationSummary::targets_markdown() const {
           std::abs(c.visc_estimate - c.true_value) <= 0.25 * c.true_value);
     }
     if (c.kind == "warmup_no_temp") {
-      counts["warm-ups without temp: reported as drift"].add(c.named == "unexplained" &&
-                                                             c.drifts);
+      counts["warm-ups without temp: reported as drift"].add(c.named == "unexplained" && c.drifts);
       counts["warm-ups without temp: internal_leakage not named"].add(
           !has(c.named_causes, "internal_leakage"));
     }
@@ -294,9 +293,10 @@ std::string EvaluationSummary::targets_markdown() const {
     out += fmt::format("| {} | {:.1f} % ({} of {}) |\n", name, 100.0 * n.met / n.of, n.met, n.of);
   }
   if (!achieved.empty()) {
-    out += fmt::format("| share of the achievable improvement, median (warm-ups with temp "
-                       "included, without temp not) | {:.2f} ({} cases) |\n",
-                       median(achieved), achieved.size());
+    out += fmt::format(
+        "| share of the achievable improvement, median (warm-ups with temp "
+        "included, without temp not) | {:.2f} ({} cases) |\n",
+        median(achieved), achieved.size());
   }
   out += fmt::format("| slowest diagnosis (wall) | {:.1f} s |\n", slowest);
   return out;

@@ -63,7 +63,7 @@ struct EvaluationSummary {
   std::string kind_markdown() const;  // issue 12's classes, one line each
   // Issue 12's targets one by one (a line each), with counts, over the classes drawn.
   std::string targets_markdown() const;
-  std::string csv() const;            // one line per case
+  std::string csv() const;  // one line per case
 };
 
 // The main parameter's estimate in a diagnosis (0 when the cause differs from `effect`).

@@ -100,15 +100,25 @@ TEST(Drift, WarmUpWithoutTemperatureIsDriftNeverALeak) {
 }
 
 TEST(HonestNone, CleanDataReachesTheFloorAndIsNone) {
-  const Diagnosis d = run("clean", "none");
-  EXPECT_EQ(d.cause, "none");
-  EXPECT_GT(d.nrmse_floor, 0.0);
-  // `none` claims the nominal model is right: its held-out error must be at the floor.
-  EXPECT_LE(d.nrmse_before, DiagnosisSettings{}.floor_factor * d.nrmse_floor);
-  const std::string json = diagnosis_json(d);
-  EXPECT_NE(json.find("\"nrmse_floor\": "), std::string::npos);
-  EXPECT_NE(json.find("\"causes\": []"), std::string::npos);
-  EXPECT_NE(json.find("\"unexplained\": null"), std::string::npos);
+  // Two clean captures: `none` is a statistical decision (a few per cent of clean captures
+  // name an effect by chance, model_diagnosis_test's HiddenEffect.CleanDataGivesNone asserts
+  // that rate with a margin), so one of the two must be `none`, and every one at its floor.
+  int nones = 0;
+  for (const char* label : {"clean 1", "clean 2"}) {
+    const Diagnosis d = run(label, "none");
+    EXPECT_GT(d.nrmse_floor, 0.0);
+    // The nominal model of clean data is right: its held-out error is at the floor (`none`
+    // needs 1.3 x; asserted with a margin).
+    EXPECT_LE(d.nrmse_before, 1.6 * d.nrmse_floor) << label;
+    if (d.cause != "none") continue;
+    ++nones;
+    EXPECT_LE(d.nrmse_before, DiagnosisSettings{}.floor_factor * d.nrmse_floor);
+    const std::string json = diagnosis_json(d);
+    EXPECT_NE(json.find("\"nrmse_floor\": "), std::string::npos);
+    EXPECT_NE(json.find("\"causes\": []"), std::string::npos);
+    EXPECT_NE(json.find("\"unexplained\": null"), std::string::npos);
+  }
+  EXPECT_GE(nones, 1) << "neither clean capture was `none`";
 }
 
 }  // namespace
