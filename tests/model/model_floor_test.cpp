@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "model/calibration_fit.hpp"
@@ -64,27 +65,37 @@ TEST(NoiseFloor, IsWhatTheTrueModelScores) {
 // A misfit is located where it was put: a wrong Kv on clean data shows in the pressures or
 // the position, and its rate follows a regressor; a leak the model lacks follows the load
 // pressure (MODEL.md's signature) more than time.
+// Three fresh captures (seeds first .. first + 2; LEAKMON_TEST_SEED=first reproduces the run):
+// the residual's rate follows the leak term only as far as the open-loop dynamics let it (a
+// pressure error moves the piston, which moves the pressures again), and in about one capture
+// in 30 the load pressure was not among the two leading regressors (seed 18301707822665037876:
+// velocity_sign +0.23, dp_dt -0.13, load_pressure -0.05 in p2). So per run: the misfit never in
+// x and time never leading, and the load pressure among the two leading in two of three.
 TEST(Misfit, FollowsTheLoadPressureForAMissingLeak) {
-  const auto seed = test::model_test_seed("Misfit/leak");
-  CaseSettings s = short_case();
-  const SyntheticCase c = draw_case(seed, "internal_leakage", s);
-  const MeasuredRecord record = measured_record(simulate_case(c));
-  const SegmentPredictor predictor(record);
-  const auto plan = split_record(record);
-  ModelParameters without_leak = true_model(c);
-  without_leak.effects.C_L = 0.0;
-  const auto floor =
-      predictor.noise_floor(true_model(c), plan.held_out, predictor.noise_levels(), seed);
-  const Misfit m = locate_misfit(predictor, without_leak, plan.held_out, floor);
-  std::printf("%s\n", describe(m).c_str());
-  ASSERT_FALSE(m.regressors.empty());
-  EXPECT_NE(m.channel, "x");
-  // The pressure's rate error is -C_L (p1 - p2) / C_h in p1: the load pressure or its close
-  // companion, the valve opening that sets it, leads; time does not.
-  EXPECT_TRUE(m.regressors[0].regressor == "load_pressure" ||
-              m.regressors[1].regressor == "load_pressure")
-      << m.regressors[0].regressor << " " << m.regressors[1].regressor;
-  EXPECT_NE(m.regressors[0].regressor, "time");
+  const auto first = test::model_test_seed("Misfit/leak (first of 3)");
+  int leading = 0;
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    const std::uint64_t seed = first + k;
+    CaseSettings s = short_case();
+    const SyntheticCase c = draw_case(seed, "internal_leakage", s);
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const SegmentPredictor predictor(record);
+    const auto plan = split_record(record);
+    ModelParameters without_leak = true_model(c);
+    without_leak.effects.C_L = 0.0;
+    const auto floor =
+        predictor.noise_floor(true_model(c), plan.held_out, predictor.noise_levels(), seed);
+    const Misfit m = locate_misfit(predictor, without_leak, plan.held_out, floor);
+    std::printf("seed %llu: %s\n", static_cast<unsigned long long>(seed), describe(m).c_str());
+    ASSERT_GE(m.regressors.size(), 2u);
+    EXPECT_NE(m.channel, "x") << "seed " << seed;
+    EXPECT_NE(m.regressors[0].regressor, "time") << "seed " << seed;
+    // The pressure's rate error is -C_L (p1 - p2) / C_h in p1: the load pressure or its close
+    // companion, the valve opening that sets it, leads.
+    leading += m.regressors[0].regressor == "load_pressure" ||
+               m.regressors[1].regressor == "load_pressure";
+  }
+  EXPECT_GE(leading, 2) << "load pressure among the two leading regressors, of 3";
 }
 
 TEST(Calibration, FlagsValuesOnTheirBounds) {
