@@ -62,7 +62,7 @@ Outcome run_case(const std::string& effect) {
 // reproduces the run): `none` is a statistical decision, and one capture in about 25 named an
 // effect before the smallest-instance rule (effect_library.hpp), so a single case cannot be
 // asserted to be clean in every run. Asserted per run, with margins: at most one of four named
-// (at a false-naming rate of 3 %, two or more of four happen in 0.5 % of runs; 0 of 100 clean
+// (at a false-naming rate of 3 %, two or more of four happen in 0.5 % of runs; 0 of 126 clean
 // captures were named in docs/model-check.md's evaluation), the nominal model at its noise
 // floor in every case (`none` needs 1.3 x the floor; 1.6 x asserted), and the leading
 // candidate's held-out evidence, median over the four, far below the naming threshold.
