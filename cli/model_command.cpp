@@ -3,6 +3,7 @@
 // and how well the workflow does on cases drawn afresh from MODEL.md.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -60,6 +61,10 @@ int run_evaluate_cases(int argc, char** argv) {
   args.option("cases", "N", "number of cases", "24")
       .option("seed", "S", "seed of the first case; case i uses S + i", "1")
       .option("duration", "SECONDS", "length of each simulated capture", "60")
+      .option("classes", "LIST",
+              "comma-separated case classes, taken in turn: library (the eleven effects and "
+              "none), pair, warmup_temp, warmup_no_temp, edge, beyond, clean",
+              "library")
       .option("out", "DIR", "output directory", std::nullopt, true);
   if (!args.parse(argc, argv, 2)) return 0;
   const long long cases = args.get_int("cases");
@@ -67,26 +72,43 @@ int run_evaluate_cases(int argc, char** argv) {
   const auto first = static_cast<std::uint64_t>(args.get_int("seed"));
   model::CaseSettings case_settings;
   case_settings.duration_s = args.get_double("duration");
-  std::vector<std::string> effects = model::effect_names();
-  effects.push_back("none");
+  std::vector<std::string> kinds;
+  const std::string list = args.get("classes");
+  for (std::size_t begin = 0; begin <= list.size();) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    const std::string kind = list.substr(begin, end - begin);
+    const auto& known = model::case_kinds();
+    if (std::find(known.begin(), known.end(), kind) == known.end()) {
+      throw UsageError(fmt::format("option '--classes': unknown class '{}'", kind));
+    }
+    kinds.push_back(kind);
+    begin = end + 1;
+  }
   model::EvaluationSummary summary;
   for (long long i = 0; i < cases; ++i) {
-    const auto& effect = effects[static_cast<std::size_t>(i) % effects.size()];
+    const auto index = static_cast<std::size_t>(i);
+    const auto& kind = kinds[index % kinds.size()];
+    const auto [effect, settings] = model::case_of_kind(kind, index / kinds.size(), case_settings);
     const auto seed = first + static_cast<std::uint64_t>(i);
-    summary.cases.push_back(model::evaluate_case(seed, effect, case_settings));
+    summary.cases.push_back(model::evaluate_case(seed, effect, settings));
+    summary.cases.back().kind = kind;
     const auto& c = summary.cases.back();
     fmt::print(
         "case {} seed {}: {} -> {} ({} true {:.4g} est {:.4g}) nrmse {:.4f} -> {:.4f} "
         "{:.1f} s; leading {} score {:.4f} t {:.2f}; line z {:.2f}\n",
         i, seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z);
+    fmt::print("  {} causes [{}] floor {:.4f} true {:.4f} achieved {:.2f} drifts {} steps {}\n",
+               c.kind, c.causes, c.nrmse_floor, c.nrmse_true, c.achieved, c.drifts, c.steps);
     std::fflush(stdout);
   }
   const std::string dir = args.get("out");
   std::filesystem::create_directories(dir);
   write_text(dir + "/cases.csv", summary.csv());
-  write_text(dir + "/summary.md", summary.markdown());
-  fmt::print("{}", summary.markdown());
+  const std::string markdown =
+      summary.targets_markdown() + "\n" + summary.kind_markdown() + "\n" + summary.markdown();
+  write_text(dir + "/summary.md", markdown);
+  fmt::print("{}", markdown);
   return 0;
 }
 
@@ -95,7 +117,8 @@ int run_evaluate_cases(int argc, char** argv) {
 int run_model(int argc, char** argv) {
   const std::string_view usage =
       "usage: leakmon model check --data CAPTURE.csv --json RESULT.json [--report DIR]\n"
-      "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n";
+      "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n"
+      "                              [--classes LIST]\n";
   if (argc < 2) throw UsageError(std::string(usage));
   const std::string_view action = argv[1];
   if (action == "-h" || action == "--help") {

@@ -17,6 +17,22 @@ sim::Parameters calibrated(sim::Parameters rig, const Calibration& c) {
   return rig;
 }
 
+// An oil with ISO VG 46's viscosity at 40 degC whose Walther line has the viscosity slope
+// `slope` at 40 degC (the slope grows as the 100 degC viscosity falls): bisection on nu(100).
+sim::Oil oil_with_slope(double slope) {
+  const double nu40 = 46.0;
+  double thin = 1.0, thick = 0.95 * nu40;  // slope(thin) > slope(thick)
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (thin + thick);
+    if (sim::Oil(nu40, mid).viscosity_slope(sim::kReferenceTemperature) > slope) {
+      thin = mid;
+    } else {
+      thick = mid;
+    }
+  }
+  return sim::Oil(nu40, 0.5 * (thin + thick));
+}
+
 }  // namespace
 
 ActuatorModel::ActuatorModel(const ModelParameters& parameters, const sim::Parameters& rig)
@@ -37,6 +53,7 @@ ActuatorModel::ActuatorModel(const ModelParameters& parameters, const sim::Param
   c_.external_chamber = e.external_chamber;
   c_.F_C = e.F_C;
   c_.alpha = e.alpha;
+  if (e.visc_slope > 0.0) oil_ = oil_with_slope(e.visc_slope);
   lagging_ = e.tau_s > 0.0;
   if (lagging_) {
     c_.lag_tau_s = e.tau_s;
@@ -70,8 +87,8 @@ double ActuatorModel::spool_input(double u) const {
 }
 
 ActuatorState ActuatorModel::derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
-                                        double spool_in, double t) const {
-  const sim::ActuatorRates r = sim::actuator_rates(c, t, spool_in, 0.0, parameters_.effects.C_L,
+                                        double spool_in, double w, double t) const {
+  const sim::ActuatorRates r = sim::actuator_rates(c, t, spool_in, w, parameters_.effects.C_L,
                                                    c.C_E, s.xs, s.x, s.v, s.p1, s.p2);
   ActuatorState d{r.xs, r.x, r.v, r.p1, r.p2, 0.0};
   if (lagging_) {
@@ -89,28 +106,39 @@ ActuatorState axpy(const ActuatorState& a, double h, const ActuatorState& d) {
 
 }  // namespace
 
-void ActuatorModel::advance(ActuatorState& state, double u, double t0, double dt) const {
+sim::ActuatorCoefficients ActuatorModel::coefficients_at(double T) const {
+  sim::ActuatorCoefficients c = c_;
+  sim::apply_conditions(c, rig_, oil_, T, rig_.ps);
+  return c;
+}
+
+void ActuatorModel::advance(ActuatorState& state, double u, double t0, double dt, double w) const {
+  advance(state, u, t0, dt, w, c_);
+}
+
+void ActuatorModel::advance(ActuatorState& state, double u, double t0, double dt, double w,
+                            const sim::ActuatorCoefficients& base) const {
   const double spool_in = spool_input(u);
   const int n = substeps(dt);
   const double h = dt / n;
   // The widened band only where friction is on and the step needs it (a copy of the
   // coefficients, so the shared rates stay the only place the equations live).
-  const sim::ActuatorCoefficients* c = &c_;
+  const sim::ActuatorCoefficients* c = &base;
   sim::ActuatorCoefficients widened;
-  if (c_.F_C != 0.0) {
+  if (base.F_C != 0.0) {
     const double v_fric = friction_velocity(h);
-    if (v_fric != c_.friction_velocity) {
-      widened = c_;
+    if (v_fric != base.friction_velocity) {
+      widened = base;
       widened.friction_velocity = v_fric;
       c = &widened;
     }
   }
   for (int i = 0; i < n; ++i) {
     const double t = t0 + i * h;
-    const ActuatorState k1 = derivative(*c, state, spool_in, t);
-    const ActuatorState k2 = derivative(*c, axpy(state, h / 2, k1), spool_in, t + h / 2);
-    const ActuatorState k3 = derivative(*c, axpy(state, h / 2, k2), spool_in, t + h / 2);
-    const ActuatorState k4 = derivative(*c, axpy(state, h, k3), spool_in, t + h);
+    const ActuatorState k1 = derivative(*c, state, spool_in, w, t);
+    const ActuatorState k2 = derivative(*c, axpy(state, h / 2, k1), spool_in, w, t + h / 2);
+    const ActuatorState k3 = derivative(*c, axpy(state, h / 2, k2), spool_in, w, t + h / 2);
+    const ActuatorState k4 = derivative(*c, axpy(state, h, k3), spool_in, w, t + h);
     state.xs += h / 6 * (k1.xs + 2 * k2.xs + 2 * k3.xs + k4.xs);
     state.x += h / 6 * (k1.x + 2 * k2.x + 2 * k3.x + k4.x);
     state.v += h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v);

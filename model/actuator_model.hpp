@@ -46,21 +46,31 @@ class ActuatorModel {
   // The tanh velocity scale used with sub-step h: 1e-3, widened where h cannot resolve it.
   double friction_velocity(double h) const;
 
-  // Advances `state` from t0 over dt with the valve command u held (zero-order hold).
-  void advance(ActuatorState& state, double u, double t0, double dt) const;
+  // Advances `state` from t0 over dt with the valve command u held (zero-order hold). w is the
+  // spool flow noise held over the step: 0 (its mean) for prediction; the noise floor
+  // (SegmentPredictor::noise_floor) draws it.
+  void advance(ActuatorState& state, double u, double t0, double dt, double w = 0.0) const;
   Reading read(const ActuatorState& state) const;
+
+  // The same step with the coefficients of the oil at T [degC] (oil_temperature): the oil's
+  // viscosity slope is the model's visc_slope (ISO VG 46's viscosity at 40 degC, the one at
+  // 100 degC chosen to give that slope), the laws of apply_conditions (sim/actuator.hpp).
+  sim::ActuatorCoefficients coefficients_at(double T) const;
+  void advance(ActuatorState& state, double u, double t0, double dt, double w,
+               const sim::ActuatorCoefficients& c) const;
 
   // Spool input sat((u + u0) / u_max) of MODEL.md's spool equation.
   double spool_input(double u) const;
 
  private:
   ActuatorState derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
-                           double spool_in, double t) const;
+                           double spool_in, double w, double t) const;
 
   ModelParameters parameters_;
   sim::Parameters rig_;
   sim::ActuatorCoefficients c_;
   bool lagging_ = false;
+  sim::Oil oil_ = sim::Oil::standard();
 };
 
 }  // namespace leakmon::model

@@ -169,4 +169,25 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
   return result;
 }
 
+std::vector<std::string> calibration_at_bound(const Calibration& c, double tolerance) {
+  const double values[kCalibrationCount] = {c.beta, c.Kv, c.m, c.b};
+  const char* names[kCalibrationCount] = {"beta", "Kv", "m", "b"};
+  std::vector<std::string> out;
+  for (int i = 0; i < kCalibrationCount; ++i) {
+    const double v = values[i] / kScales[i];
+    const double margin = tolerance * (kUpper[i] - kLower[i]);
+    if (v <= kLower[i] + margin || v >= kUpper[i] - margin) out.emplace_back(names[i]);
+  }
+  return out;
+}
+
+Calibration within_bounds(const Calibration& c) {
+  // A tenth of the way in from a bound: the solver then has room in both directions.
+  const auto inside = [](double v, int i) {
+    const double margin = 0.1 * (kUpper[i] - kLower[i]);
+    return std::clamp(v / kScales[i], kLower[i] + margin, kUpper[i] - margin) * kScales[i];
+  };
+  return {inside(c.beta, 0), inside(c.Kv, 1), inside(c.m, 2), inside(c.b, 3)};
+}
+
 }  // namespace leakmon::model

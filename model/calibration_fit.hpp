@@ -5,6 +5,7 @@
 
 #include <array>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "model/effect_library.hpp"
@@ -34,5 +35,12 @@ struct FitResult {
 FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> segments,
                     const EffectCandidate* candidate, const Calibration& start,
                     const FitSettings& settings = {});
+
+// The calibratable parameters (beta, Kv, m, b) that sit on the bound the fit holds them to
+// (within `tolerance` of the bound interval's width): such a value is not a calibration but a
+// sign that the model is compensating for something it lacks.
+std::vector<std::string> calibration_at_bound(const Calibration& c, double tolerance = 0.002);
+// `c` moved inside the bounds (a start for a retry).
+Calibration within_bounds(const Calibration& c);
 
 }  // namespace leakmon::model

@@ -20,7 +20,35 @@ const std::vector<std::string>& effect_names() {
   return names;
 }
 
+std::vector<std::vector<double>> EffectCandidate::split(const std::vector<double>& values) const {
+  if (parts.empty()) return {values};
+  std::vector<std::vector<double>> out;
+  std::size_t next = 0;
+  for (const auto& part : parts) {
+    std::vector<double> share;
+    for (std::size_t i = 0; i < part.parameters.size(); ++i)
+      share.push_back(value_of(values, next++));
+    out.push_back(std::move(share));
+  }
+  return out;
+}
+
+EffectCandidate combine(const std::vector<EffectCandidate>& parts) {
+  EffectCandidate joint;
+  for (const auto& part : parts) {
+    joint.effect += (joint.effect.empty() ? "" : "+") + part.effect;
+    joint.parameters.insert(joint.parameters.end(), part.parameters.begin(), part.parameters.end());
+    joint.parts.push_back(part);
+  }
+  return joint;
+}
+
 void EffectCandidate::apply(EffectParameters& e, const std::vector<double>& values) const {
+  if (!parts.empty()) {
+    const auto shares = split(values);
+    for (std::size_t i = 0; i < parts.size(); ++i) parts[i].apply(e, shares[i]);
+    return;
+  }
   std::vector<double> v(parameters.size());
   for (std::size_t i = 0; i < parameters.size(); ++i) {
     v[i] = std::clamp(value_of(values, i), parameters[i].lower, parameters[i].upper);
@@ -53,16 +81,41 @@ void EffectCandidate::apply(EffectParameters& e, const std::vector<double>& valu
   } else if (effect == "sensor_lag") {
     e.tau_s = v[0];
     e.lag_channel = channel;
+  } else if (effect == "oil_temperature") {
+    e.visc_slope = v[0];
   }
 }
 
+double EffectCandidate::smallest() const {
+  // A fifth of each range's low end (MODEL.md's effect library). The evaluation's `beyond`
+  // class draws at the low end / 1.5, so every instance it draws stays well above this.
+  if (effect == "internal_leakage") return 5e-13 / 5.0;
+  if (effect == "external_leakage") return 1e-13 / 5.0;
+  if (effect == "coulomb_friction") return 50.0 / 5.0;
+  if (effect == "entrained_air") return 0.02 / 5.0;
+  if (effect == "valve_overlap") return 0.01 / 5.0;
+  if (effect == "valve_bias") return 0.05 / 5.0;
+  if (effect == "supply_droop") return 5e9 / 5.0;
+  if (effect == "sensor_offset") return 5e4 / 5.0;
+  if (effect == "sensor_lag") return 0.002 / 5.0;
+  return 0.0;  // spool lag: slower than the nominal spool; ripple: its line test
+}
+
 bool EffectCandidate::plausible(const std::vector<double>& values) const {
+  if (!parts.empty()) {
+    const auto shares = split(values);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (!parts[i].plausible(shares[i])) return false;
+    }
+    return true;
+  }
   const double main = value_of(values, 0);
   const auto& p = parameters.front();
   // A main parameter pinned at a bound means the effect's shape does not fit the data.
   const double span = p.upper - p.lower;
   if (main <= p.lower + 1e-3 * span || main >= p.upper - 1e-3 * span) return false;
   if (effect == "spool_lag") return main > 1.5 * 2.5e-3;  // slower than the nominal spool
+  if (std::abs(main) < smallest()) return false;
   // Leaks, friction, air, dead band and droop have a sign; the solver may cross zero, but a
   // negative one is not an instance of the effect.
   const bool signed_effect = effect == "valve_bias" || effect == "supply_ripple" ||
@@ -70,17 +123,17 @@ bool EffectCandidate::plausible(const std::vector<double>& values) const {
   return signed_effect || main > 0.0;
 }
 
-std::vector<EffectCandidate> effect_library(double ripple_hz) {
+std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature) {
   std::vector<EffectCandidate> out;
-  out.push_back({"internal_leakage", "", {{"C_L", 1e-12, 1e-12, -2e-12, 5e-11}}});
+  out.push_back({"internal_leakage", "", {{"C_L", 1e-12, 1e-12, -2e-12, 5e-11}}, {}});
   for (const char* chamber : {"chamber 1", "chamber 2"}) {
-    out.push_back({"external_leakage", chamber, {{"C_E", 1e-12, 5e-13, -1e-12, 2e-11}}});
+    out.push_back({"external_leakage", chamber, {{"C_E", 1e-12, 5e-13, -1e-12, 2e-11}}, {}});
   }
-  out.push_back({"coulomb_friction", "", {{"F_C", 100.0, 100.0, -200.0, 4000.0}}});
-  out.push_back({"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}}});
-  out.push_back({"valve_overlap", "", {{"d", 0.01, 0.01, -0.01, 0.2}}});
-  out.push_back({"valve_bias", "", {{"u0", 0.1, 0.02, -3.0, 3.0}}});
-  out.push_back({"spool_lag", "", {{"tau", 0.005, 0.006, 5e-4, 0.1}}});
+  out.push_back({"coulomb_friction", "", {{"F_C", 100.0, 100.0, -200.0, 4000.0}}, {}});
+  out.push_back({"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}}, {}});
+  out.push_back({"valve_overlap", "", {{"d", 0.01, 0.01, -0.01, 0.2}}, {}});
+  out.push_back({"valve_bias", "", {{"u0", 0.1, 0.02, -3.0, 3.0}}, {}});
+  out.push_back({"spool_lag", "", {{"tau", 0.005, 0.006, 5e-4, 0.1}}, {}});
   if (ripple_hz > 0.0) {
     out.push_back({"supply_ripple",
                    "",
@@ -89,14 +142,18 @@ std::vector<EffectCandidate> effect_library(double ripple_hz) {
                     // of 0.01 Hz already turns the phase by 3.8 rad over 60 s, far outside
                     // the fit's basin.
                     {"f", 1e-4, ripple_hz, ripple_hz, ripple_hz},
-                    {"", 1e5, 0.0, -5e6, 5e6}}});
+                    {"", 1e5, 0.0, -5e6, 5e6}},
+                   {}});
   }
-  out.push_back({"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}}});
+  out.push_back({"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}}, {}});
   for (const char* channel : {"p1", "p2"}) {
-    out.push_back({"sensor_offset", channel, {{"offset", 1e5, 0.0, -3e6, 3e6}}});
+    out.push_back({"sensor_offset", channel, {{"offset", 1e5, 0.0, -3e6, 3e6}}, {}});
   }
   for (const char* channel : {"p1", "p2"}) {
-    out.push_back({"sensor_lag", channel, {{"tau_s", 0.002, 0.004, 5e-4, 0.1}}});
+    out.push_back({"sensor_lag", channel, {{"tau_s", 0.002, 0.004, 5e-4, 0.1}}, {}});
+  }
+  if (has_temperature) {
+    out.push_back({"oil_temperature", "", {{"visc_slope", 0.01, 0.045, 0.0, 0.12}}, {}});
   }
   return out;
 }

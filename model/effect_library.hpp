@@ -23,15 +23,31 @@ struct EffectCandidate {
   std::string effect;                     // MODEL.md's name
   std::string variant;                    // "chamber 2", "p1", ... ; empty when the effect has none
   std::vector<FreeParameter> parameters;  // the first one is the effect's main parameter
+  // The smallest |main parameter| that is still an instance of the effect: a fifth of the low
+  // end of MODEL.md's range (0: no such floor). A fit far below it is the model absorbing
+  // something else, not the effect (docs/model-check.md: a clean capture's Coulomb friction
+  // of 0.4 N, against MODEL.md's 50-400 N, acted only through tanh(v / 1e-3) as extra damping
+  // at rest and soaked up the noise of each segment's starting velocity).
+  double smallest() const;
   // Writes the discrete settings and parameter values into `e`.
   void apply(EffectParameters& e, const std::vector<double>& values) const;
   // Is a fitted main parameter a physical instance of the effect (e.g. a leak, not a source)?
   bool plausible(const std::vector<double>& values) const;
+  // Set for a joint candidate (combine()): its parts, whose parameters `parameters` holds one
+  // after the other; apply() and plausible() then act on each part's share of the values.
+  std::vector<EffectCandidate> parts;
+  // `values` cut into the parts' shares (one share, all of them, for a single candidate).
+  std::vector<std::vector<double>> split(const std::vector<double>& values) const;
 };
 
+// Several effects fitted jointly (the model check's forward selection): every part's effect
+// parameters free at once, each applied to the model in turn.
+EffectCandidate combine(const std::vector<EffectCandidate>& parts);
+
 // Every candidate, in MODEL.md's order. `ripple_hz` seeds the supply_ripple frequency (0: the
-// capture shows no spectral line, and the ripple candidate is left out).
-std::vector<EffectCandidate> effect_library(double ripple_hz);
+// capture shows no spectral line, and the ripple candidate is left out); oil_temperature
+// ("Drifting operating conditions") is a candidate only when the capture has `temp`.
+std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature = false);
 
 // The eleven effect names of MODEL.md, in its order.
 const std::vector<std::string>& effect_names();

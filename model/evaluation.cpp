@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 #include "model/effect_library.hpp"
 
@@ -47,18 +49,43 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
     break;
   }
   if (d.ripple_line) out.line_z = d.ripple_line->held_out_z;
+  out.nrmse_floor = d.nrmse_floor;
+  out.truths = c.effects;
+  for (const auto& cause : d.causes) {
+    out.named_causes.push_back(cause.effect);
+    if (cause.effect == "oil_temperature") {
+      for (const auto& p : cause.params) {
+        if (p.name == "visc_slope") out.visc_estimate = p.value;
+      }
+    }
+  }
+  const SegmentPredictor predictor(record);
+  out.nrmse_true = predictor.nrmse(true_model(c), d.held_out_used);
+  const double achievable = out.nrmse_before - out.nrmse_true;
+  out.achieved = achievable > 0.0 ? (out.nrmse_before - out.nrmse_after) / achievable : 1.0;
+  for (const auto& cause : d.causes) out.causes += (out.causes.empty() ? "" : "+") + cause.effect;
+  out.drifts = d.drifts || (d.unexplained && d.unexplained->drifts);
+  for (const auto& s : d.steps) {
+    out.steps += fmt::format("{}{}:{:.3f}/{:.1f}{}", out.steps.empty() ? "" : ";", s.effect,
+                             s.score, s.significance, s.accepted ? "" : "(rejected)");
+  }
+  for (const auto& name : d.at_bound) out.at_bound += (out.at_bound.empty() ? "" : "+") + name;
   return out;
 }
 
 std::string EvaluationSummary::csv() const {
   std::string out =
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
-      "nrmse_after,seconds,leading,leading_score,leading_significance,line_z\n";
+      "nrmse_after,seconds,leading,leading_score,leading_significance,line_z,nrmse_floor,"
+      "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate\n";
   for (const auto& c : cases) {
-    out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f}\n",
-                       c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate,
-                       c.nrmse_before, c.nrmse_after, c.seconds, c.leading, c.leading_score,
-                       c.leading_significance, c.line_z);
+    out += fmt::format(
+        "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{},"
+        "{},{:.6g},{:.4f},{:.6g}\n",
+        c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
+        c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z,
+        c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps, c.kind, c.nrmse_true,
+        c.achieved, c.visc_estimate);
   }
   return out;
 }
@@ -104,6 +131,174 @@ std::string EvaluationSummary::markdown() const {
     }
     out += "\n";
   }
+  return out;
+}
+
+const std::vector<std::string>& case_kinds() {
+  static const std::vector<std::string> kinds = {
+      "library", "pair", "warmup_temp", "warmup_no_temp", "edge", "beyond", "clean"};
+  return kinds;
+}
+
+std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::size_t n,
+                                                  CaseSettings base) {
+  // Pairs of effects that each show clearly on their own (issue 12's two examples first).
+  static const std::vector<std::string> pairs = {"sensor_lag+spool_lag",
+                                                 "sensor_lag+valve_overlap",
+                                                 "internal_leakage+coulomb_friction",
+                                                 "valve_bias+supply_droop",
+                                                 "external_leakage+sensor_offset",
+                                                 "spool_lag+internal_leakage",
+                                                 "valve_overlap+sensor_offset",
+                                                 "coulomb_friction+valve_bias"};
+  const auto& names = effect_names();
+  if (kind == "library") {
+    return {n % (names.size() + 1) < names.size() ? names[n % (names.size() + 1)] : "none", base};
+  }
+  if (kind == "pair") return {pairs[n % pairs.size()], base};
+  if (kind == "warmup_temp" || kind == "warmup_no_temp") {
+    base.record_temperature = kind == "warmup_temp";
+    return {"oil_temperature", base};
+  }
+  if (kind == "edge" || kind == "beyond") {
+    base.edge = kind == "edge" ? 1.0 : 1.5;
+    return {names[n % names.size()], base};
+  }
+  if (kind == "clean") return {"none", base};
+  throw std::invalid_argument(fmt::format("unknown case class '{}'", kind));
+}
+
+namespace {
+
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+}  // namespace
+
+std::string EvaluationSummary::kind_markdown() const {
+  std::string out =
+      "| class | cases | target | met | `internal_leakage` named wrongly | `none` | `unexplained` "
+      "| "
+      "median NRMSE before / after / true / floor | median share of achievable improvement |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& kind : case_kinds()) {
+    int n = 0, met = 0, wrong_leak = 0, nones = 0, unexplained = 0;
+    std::vector<double> before, after, truth, floor, achieved;
+    std::string target;
+    for (const auto& c : cases) {
+      if (c.kind != kind) continue;
+      ++n;
+      const bool leak_true = std::any_of(c.truths.begin(), c.truths.end(), [](const auto& t) {
+        return t.effect == "internal_leakage";
+      });
+      wrong_leak += !leak_true && has(c.named_causes, "internal_leakage");
+      nones += c.named == "none";
+      unexplained += c.named == "unexplained";
+      before.push_back(c.nrmse_before);
+      after.push_back(c.nrmse_after);
+      truth.push_back(c.nrmse_true);
+      floor.push_back(c.nrmse_floor);
+      if (!c.truths.empty() && kind != "warmup_no_temp") achieved.push_back(c.achieved);
+      if (kind == "library" || kind == "edge" || kind == "beyond") {
+        target = "cause right and main parameter within 25 %";
+        met += c.parameter_within(0.25);
+      } else if (kind == "pair") {
+        target = "both named, no third";
+        bool both = true;
+        for (const auto& t : c.truths) both = both && has(c.named_causes, t.effect);
+        met += both && c.named_causes.size() == c.truths.size();
+      } else if (kind == "warmup_temp") {
+        target = "oil_temperature named, visc_slope within 25 %";
+        met += has(c.named_causes, "oil_temperature") &&
+               std::abs(c.visc_estimate - c.true_value) <= 0.25 * c.true_value;
+      } else if (kind == "warmup_no_temp") {
+        target = "reported as drift (unexplained, drifts)";
+        met += c.named == "unexplained" && c.drifts;
+      } else if (kind == "clean") {
+        target = "none";
+        met += c.named == "none";
+      }
+    }
+    if (n == 0) continue;
+    out += fmt::format(
+        "| {} | {} | {} | {:.1f} % ({}) | {} | {} | {} | {:.4f} / {:.4f} / {:.4f} / {:.4f} | {} "
+        "|\n",
+        kind, n, target, 100.0 * met / n, met, wrong_leak, nones, unexplained, median(before),
+        median(after), median(truth), median(floor),
+        achieved.empty() ? std::string("-") : fmt::format("{:.2f}", median(achieved)));
+  }
+  return out;
+}
+
+std::string EvaluationSummary::targets_markdown() const {
+  struct Count {
+    int met = 0, of = 0;
+    void add(bool ok) {
+      met += ok;
+      ++of;
+    }
+  };
+  std::map<std::string, Count> counts;
+  std::vector<double> achieved;
+  double slowest = 0.0;
+  for (const auto& c : cases) {
+    slowest = std::max(slowest, c.seconds);
+    if (!c.truths.empty() && c.kind != "warmup_no_temp") achieved.push_back(c.achieved);
+    const bool single = c.kind == "library" || c.kind == "edge" || c.kind == "beyond";
+    if (single && !c.truths.empty()) {
+      const std::string where = c.kind == "library" ? "" : " (" + c.kind + ")";
+      counts["single effects: cause right" + where].add(c.named == c.truth);
+      counts["single effects: main parameter within 25 %" + where].add(c.parameter_within(0.25));
+    }
+    if (c.kind == "pair") {
+      bool both = true;
+      for (const auto& t : c.truths) both = both && has(c.named_causes, t.effect);
+      bool third = false;
+      for (const auto& n : c.named_causes) {
+        third = third || std::none_of(c.truths.begin(), c.truths.end(),
+                                      [&](const TrueEffect& t) { return t.effect == n; });
+      }
+      counts["pairs: both named"].add(both);
+      counts["pairs: no third effect named"].add(!third);
+    }
+    if (c.kind == "warmup_temp") {
+      counts["warm-ups with temp: oil_temperature named, visc_slope within 25 %"].add(
+          has(c.named_causes, "oil_temperature") &&
+          std::abs(c.visc_estimate - c.true_value) <= 0.25 * c.true_value);
+    }
+    if (c.kind == "warmup_no_temp") {
+      counts["warm-ups without temp: reported as drift"].add(c.named == "unexplained" && c.drifts);
+      counts["warm-ups without temp: internal_leakage not named"].add(
+          !has(c.named_causes, "internal_leakage"));
+    }
+    if (c.kind == "clean" || (c.kind == "library" && c.truths.empty())) {
+      counts["clean data: none"].add(c.named == "none");
+    }
+    // `none` claims the nominal model is right; where an effect is present and the nominal
+    // model misses the floor (DiagnosisSettings::floor_factor) it must not be said.
+    if (!c.truths.empty() && c.nrmse_before > DiagnosisSettings{}.floor_factor * c.nrmse_floor) {
+      counts["misfit above the floor: never none"].add(c.named != "none");
+    }
+  }
+  std::string out = "| target | met |\n|---|---|\n";
+  for (const auto& [name, n] : counts) {
+    out += fmt::format("| {} | {:.1f} % ({} of {}) |\n", name, 100.0 * n.met / n.of, n.met, n.of);
+  }
+  if (!achieved.empty()) {
+    out += fmt::format(
+        "| share of the achievable improvement, median (warm-ups with temp "
+        "included, without temp not) | {:.2f} ({} cases) |\n",
+        median(achieved), achieved.size());
+  }
+  out += fmt::format("| slowest diagnosis (wall) | {:.1f} s |\n", slowest);
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/diagnosis.hpp"
@@ -14,6 +15,14 @@ namespace leakmon::model {
 
 struct CaseOutcome {
   std::uint64_t seed = 0;
+  std::string kind = "library";    // the evaluation class (case_kinds())
+  std::vector<TrueEffect> truths;  // every effect present
+  std::vector<std::string> named_causes;
+  double visc_estimate = 0.0;  // oil_temperature's visc_slope when named
+  // The generator's true model on the same held-out segments: the best any extension can do.
+  // achieved = (before - after) / (before - true), the share of the achievable improvement.
+  double nrmse_true = 0.0;
+  double achieved = 0.0;
   std::string truth, named;
   std::string main_parameter;
   double true_value = 0.0, estimate = 0.0;  // main parameter; estimate 0 when not named
@@ -23,7 +32,12 @@ struct CaseOutcome {
   // margins to the naming thresholds (DiagnosisSettings) over many cases.
   std::string leading;
   double leading_score = 0.0, leading_significance = 0.0;
-  double line_z = 0.0;  // the supply-ripple line test's statistic
+  double line_z = 0.0;       // the supply-ripple line test's statistic
+  double nrmse_floor = 0.0;  // the noise floor the diagnosis estimated
+  std::string causes;        // every named effect, joined by '+' (empty: none named)
+  bool drifts = false;
+  std::string steps;     // forward selection: effect:score/t per step, ';'-separated
+  std::string at_bound;  // calibrated values on a bound, joined by '+'
   bool named_correctly() const { return truth == named; }
   bool parameter_within(double tolerance) const;
 };
@@ -34,10 +48,22 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
                           const CaseSettings& case_settings = {},
                           const DiagnosisSettings& settings = {});
 
+// The evaluation classes of issue 12: "library" (the eleven effects and none in turn),
+// "pair" (two visible effects), "warmup_temp" / "warmup_no_temp" (the oil warming up, with and
+// without the `temp` column), "edge" / "beyond" (an effect at / 1.5 times beyond its range's
+// ends), "clean".
+const std::vector<std::string>& case_kinds();
+// The n-th case of a class: its effect string and settings.
+std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::size_t n,
+                                                  CaseSettings base);
+
 struct EvaluationSummary {
   std::vector<CaseOutcome> cases;
-  std::string markdown() const;  // accuracy figures and the confusion matrix
-  std::string csv() const;       // one line per case
+  std::string markdown() const;       // accuracy figures and the confusion matrix
+  std::string kind_markdown() const;  // issue 12's classes, one line each
+  // Issue 12's targets one by one (a line each), with counts, over the classes drawn.
+  std::string targets_markdown() const;
+  std::string csv() const;  // one line per case
 };
 
 // The main parameter's estimate in a diagnosis (0 when the cause differs from `effect`).

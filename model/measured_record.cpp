@@ -107,6 +107,7 @@ MeasuredRecord read_measured_record(const std::string& path, const RecordRequire
   const auto col = [&](std::string_view name) { return *reader.column_index(name); };
   const auto xref = reader.column_index("xref");
   const auto ps = reader.column_index("ps");
+  const auto temp = reader.column_index("temp");
   MeasuredRecord rec;
   rec.source = path;
   rec.controller = controller_from(reader.metadata());
@@ -120,6 +121,7 @@ MeasuredRecord read_measured_record(const std::string& path, const RecordRequire
     rec.p2.push_back(row[col("p2")]);
     if (xref) rec.xref.push_back(row[*xref]);
     if (ps) rec.ps.push_back(row[*ps]);
+    if (temp) rec.temp.push_back(row[*temp]);
     origin.lines.push_back(reader.line_number());
   }
   return vet(std::move(rec), origin, req);
@@ -137,6 +139,7 @@ MeasuredRecord measured_record(const capture::Capture& capture, const RecordRequ
   rec.p2 = capture.column("p2");
   if (capture.has("xref")) rec.xref = capture.column("xref");
   if (capture.has("ps")) rec.ps = capture.column("ps");
+  if (capture.has("temp")) rec.temp = capture.column("temp");
   return vet(std::move(rec), RowOrigin{}, req);
 }
 

@@ -25,6 +25,7 @@ struct MeasuredRecord {
   std::vector<double> t, u, x, p1, p2;
   std::vector<double> xref;  // empty when the capture has none
   std::vector<double> ps;    // supply pressure; empty when the capture has none
+  std::vector<double> temp;  // oil temperature [degC]; empty when the capture has none
   std::vector<bool> valid;   // false where any of u, x, p1, p2 is a gap
 
   std::size_t size() const { return t.size(); }

@@ -35,6 +35,9 @@ struct EffectParameters {
   PressureChannel offset_channel = PressureChannel::p1;
   double tau_s = 0.0;  // sensor_lag [s]
   PressureChannel lag_channel = PressureChannel::p1;
+  // oil_temperature: -d ln(nu)/dT at 40 degC [1/K]; 0 = the model ignores the oil's
+  // temperature (needs the capture's `temp` column).
+  double visc_slope = 0.0;
 };
 
 struct ModelParameters {

@@ -57,18 +57,75 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
       "measured command from the measured state, see docs/model-check.md).\n\n",
       r.duration(), 1.0 / r.dt, d.fitting_used.size(), d.held_out_used.size());
   out += "## Verdict\n\n";
+  out += fmt::format(
+      "Noise floor: the held-out NRMSE that the noise alone leaves, from this capture's "
+      "transducer noise (x {:.3g} m, p1 {:.3g} Pa, p2 {:.3g} Pa) and the spool flow noise: "
+      "**{:.4f}**. The calibrated nominal model scores {:.4f}.\n\n",
+      d.noise.x, d.noise.p1, d.noise.p2, d.nrmse_floor, d.nrmse_before);
   if (d.cause == "none") {
     out +=
-        "No effect of the library predicts the held-out data significantly better than the "
-        "calibrated nominal model: the simulation agrees with the measurement within the "
-        "noise (the spool flow noise is process noise, not a discrepancy).\n\n";
+        "The calibrated nominal model reaches the noise floor and no effect of the library "
+        "predicts the held-out data significantly better: the simulation agrees with the "
+        "measurement within the noise.\n\n";
+  } else if (d.cause == "unexplained") {
+    out += fmt::format(
+        "**Unexplained misfit.** The calibrated nominal model misses the noise floor "
+        "({:.4f} against {:.4f}) and {}.\n\n",
+        d.nrmse_before, d.nrmse_floor,
+        d.drifts ? "the effect that would fit it on average does not hold still over the "
+                   "capture (see Drift): the rig's operating conditions change, which a "
+                   "constant fault such as internal leakage does not explain"
+                 : "no effect of the library, alone or combined, explains it");
   } else {
     out += fmt::format(
-        "The nominal model misses **{}**. Extending the model with it lowers the "
+        "The nominal model misses **{}**. Extending the model with {} lowers the "
         "held-out NRMSE from {:.4f} to {:.4f}.\n\n",
-        d.cause, d.nrmse_before, d.nrmse_after);
-    out += "| parameter | fitted value | standard error |\n|---|---|---|\n";
-    out += parameter_lines(d.params) + "\n";
+        d.cause, d.causes.size() > 1 ? "them" : "it", d.nrmse_before, d.nrmse_after);
+    for (const auto& cause : d.causes) {
+      out += fmt::format("**{}**\n\n| parameter | fitted value | standard error |\n|---|---|---|\n",
+                         cause.effect);
+      out += parameter_lines(cause.params) + "\n";
+    }
+  }
+  if (!d.steps.empty()) {
+    out +=
+        "Forward selection (each step fitted jointly with the calibration and the effects "
+        "before it; gain on held-out data over the previous step's model):\n\n"
+        "| step | effect | held-out NRMSE | score | significance | named |\n"
+        "|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < d.steps.size(); ++i) {
+      const auto& st = d.steps[i];
+      out += fmt::format("| {} | {} | {:.4f} | {:.4f} | {:.2f} | {} |\n", i + 1, st.effect,
+                         st.nrmse, st.score, st.significance, st.accepted ? "yes" : "no");
+    }
+    out += "\n";
+  }
+  if (d.unexplained) {
+    out += "## Where the misfit lives\n\n" + describe(*d.unexplained) + "\n\n";
+  }
+  if (!d.at_bound.empty() || !d.nominal_at_bound.empty()) {
+    out += "**Calibration on a bound**: ";
+    for (const auto& name : d.at_bound) out += name + " ";
+    if (!d.nominal_at_bound.empty()) {
+      out += "(calibrated nominal model: ";
+      for (const auto& name : d.nominal_at_bound) out += name + " ";
+      out += ")";
+    }
+    out +=
+        ". A calibrated value on its bound is not a calibration: the model compensates for "
+        "something it lacks (the fit was retried from the starts the effect candidates "
+        "suggested).\n\n";
+  }
+  if (!d.drift.empty()) {
+    out +=
+        "## Drift (first third against last third of the capture)\n\n"
+        "| parameter | first third | last third | z | drifts |\n|---|---|---|---|---|\n";
+    for (const auto& c : d.drift) {
+      out +=
+          fmt::format("| {} | {:.4g} +- {:.2g} | {:.4g} +- {:.2g} | {:.1f} | {} |\n", c.parameter,
+                      c.early, c.early_error, c.late, c.late_error, c.z, c.drifts ? "yes" : "no");
+    }
+    out += "\n";
   }
   out +=
       "## Calibration (fitted, not a cause)\n\n| parameter | value | standard error |\n"

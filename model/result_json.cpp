@@ -36,12 +36,79 @@ std::string errors_object(const std::vector<NamedValue>& params) {
   return out + "}";
 }
 
+std::string string_list(const std::vector<std::string>& names) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    out += fmt::format("{}\"{}\"", i ? ", " : "", names[i]);
+  }
+  return out + "]";
+}
+
+std::string channel_object(const std::array<double, 3>& v) {
+  return fmt::format("{{\"x\": {}, \"p1\": {}, \"p2\": {}}}", number(v[0]), number(v[1]),
+                     number(v[2]));
+}
+
+std::string misfit_object(const Misfit& m) {
+  std::string regressors = "{";
+  for (std::size_t i = 0; i < m.regressors.size(); ++i) {
+    regressors += fmt::format("{}\"{}\": {}", i ? ", " : "", m.regressors[i].regressor,
+                              number(m.regressors[i].correlation));
+  }
+  regressors += "}";
+  return fmt::format(
+      "{{\"channel\": \"{}\", \"regressor\": \"{}\", \"correlation\": {}, "
+      "\"regressors\": {}, \"band_hz\": [{}, {}], \"band_share\": {}, \"drifts\": {}, "
+      "\"late_over_early\": {}, \"trend_t\": {}, \"channel_nrmse\": {}, "
+      "\"channel_floor\": {}}}",
+      m.channel, m.regressors.empty() ? "" : m.regressors[0].regressor,
+      number(m.regressors.empty() ? 0.0 : m.regressors[0].correlation), regressors,
+      number(m.band_low_hz), number(m.band_high_hz), number(m.band_share),
+      m.drifts ? "true" : "false", number(m.late_over_early), number(m.trend_t),
+      channel_object(m.channel_nrmse), channel_object(m.channel_floor));
+}
+
 }  // namespace
 
 std::string diagnosis_json(const Diagnosis& d) {
   std::string out = "{\n";
   out += fmt::format("  \"cause\": \"{}\",\n", d.cause);
   out += fmt::format("  \"params\": {},\n", params_object(d.params));
+  out += "  \"causes\": [";
+  for (std::size_t i = 0; i < d.causes.size(); ++i) {
+    out += fmt::format("{}{{\"cause\": \"{}\", \"params\": {}, \"param_errors\": {}}}",
+                       i ? ", " : "", d.causes[i].effect, params_object(d.causes[i].params),
+                       errors_object(d.causes[i].params));
+  }
+  out += "],\n";
+  out += "  \"steps\": [";
+  for (std::size_t i = 0; i < d.steps.size(); ++i) {
+    const auto& s = d.steps[i];
+    out += fmt::format(
+        "{}{{\"effect\": \"{}\", \"nrmse\": {}, \"score\": {}, \"significance\": {}, "
+        "\"accepted\": {}}}",
+        i ? ", " : "", s.effect, number(s.nrmse), number(s.score), number(s.significance),
+        s.accepted ? "true" : "false");
+  }
+  out += "],\n";
+  out += fmt::format("  \"nrmse_floor\": {},\n", number(d.nrmse_floor));
+  out += fmt::format("  \"unexplained\": {},\n",
+                     d.unexplained ? misfit_object(*d.unexplained) : "null");
+  out += fmt::format("  \"at_bound\": {},\n", string_list(d.at_bound));
+  out += fmt::format("  \"nominal_at_bound\": {},\n", string_list(d.nominal_at_bound));
+  out += fmt::format("  \"drifts\": {},\n", d.drifts ? "true" : "false");
+  out += "  \"drift\": [";
+  for (std::size_t i = 0; i < d.drift.size(); ++i) {
+    const auto& c = d.drift[i];
+    out += fmt::format(
+        "{}{{\"parameter\": \"{}\", \"early\": {}, \"early_error\": {}, \"late\": {}, "
+        "\"late_error\": {}, \"z\": {}, \"drifts\": {}}}",
+        i ? ", " : "", c.parameter, number(c.early), number(c.early_error), number(c.late),
+        number(c.late_error), number(c.z), c.drifts ? "true" : "false");
+  }
+  out += "],\n";
+  out += fmt::format("  \"transducer_noise\": {},\n",
+                     channel_object({d.noise.x, d.noise.p1, d.noise.p2}));
   out += fmt::format("  \"param_errors\": {},\n", errors_object(d.params));
   const auto& c = d.calibrated;
   const auto& e = d.calibrated_errors;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 namespace leakmon::model {
 namespace {
@@ -98,6 +99,10 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
   const ActuatorModel model(parameters, rig_);
   const std::vector<double> xs = spool_positions(model);
   const auto& e = parameters.effects;
+  // oil_temperature: the coefficients follow the measured oil temperature, sample by sample
+  // (it changes over minutes; a missing reading holds the last one).
+  const bool follows_temperature = e.visc_slope > 0.0 && !record_.temp.empty();
+  sim::ActuatorCoefficients at_temperature = model.coefficients();
   for (const auto& seg : segments) {
     const std::size_t k0 = seg.begin;
     ActuatorState s;
@@ -116,7 +121,11 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
     bool diverged = false;
     for (std::size_t j = 1; j < seg.length; ++j) {
       const std::size_t k = k0 + j;
-      if (!diverged) {
+      if (!diverged && follows_temperature) {
+        const double T = record_.temp[k - 1];
+        if (std::isfinite(T)) at_temperature = model.coefficients_at(T);
+        model.advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt, 0.0, at_temperature);
+      } else if (!diverged) {
         model.advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt);
         diverged = !(std::isfinite(s.x) && std::isfinite(s.p1) && std::isfinite(s.p2) &&
                      std::abs(s.x) < 10.0 * rig_.L && s.p1 < 1e9 && s.p2 < 1e9);
@@ -161,11 +170,11 @@ void SegmentPredictor::residuals(const ModelParameters& parameters,
   });
 }
 
-double SegmentPredictor::nrmse(const Prediction& prediction,
-                               std::span<const Segment> segments) const {
+std::array<double, 3> SegmentPredictor::channel_nrmse(const Prediction& prediction,
+                                                      std::span<const Segment> segments) const {
   const std::vector<double>* measured[3] = {&record_.x, &record_.p1, &record_.p2};
   const std::vector<double>* predicted[3] = {&prediction.x, &prediction.p1, &prediction.p2};
-  double total = 0.0;
+  std::array<double, 3> out{};
   for (int c = 0; c < 3; ++c) {
     double err2 = 0.0, sum = 0.0, sum2 = 0.0;
     std::size_t n = 0;
@@ -180,12 +189,133 @@ double SegmentPredictor::nrmse(const Prediction& prediction,
         ++n;
       }
     }
-    if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+    if (n == 0) return {std::numeric_limits<double>::quiet_NaN()};
     const double mean = sum / static_cast<double>(n);
     const double var = std::max(sum2 / static_cast<double>(n) - mean * mean, 1e-30);
-    total += std::sqrt(err2 / static_cast<double>(n) / var);
+    out[static_cast<std::size_t>(c)] = std::sqrt(err2 / static_cast<double>(n) / var);
   }
-  return total / 3.0;
+  return out;
+}
+
+double SegmentPredictor::nrmse(const Prediction& prediction,
+                               std::span<const Segment> segments) const {
+  const auto c = channel_nrmse(prediction, segments);
+  return (c[0] + c[1] + c[2]) / 3.0;
+}
+
+NoiseLevels SegmentPredictor::noise_levels() const {
+  const auto sigma = [&](const std::vector<double>& y) {
+    std::vector<double> d;
+    d.reserve(y.size());
+    for (std::size_t k = 1; k + 2 < y.size(); ++k) {
+      if (!(record_.valid[k - 1] && record_.valid[k] && record_.valid[k + 1] &&
+            record_.valid[k + 2]))
+        continue;
+      const double third = y[k + 2] - 3.0 * y[k + 1] + 3.0 * y[k] - y[k - 1];
+      d.push_back(third * third);
+    }
+    if (d.empty()) return 0.0;
+    // The mean square of the smallest 90 %: the largest tenth (fast transients) left out. A
+    // median would be robust too but is coarse on readings quantised to one LSB (the third
+    // differences take few distinct values); for Gaussian values the kept mean square is
+    // 0.6231 times the full one (truncation at the 90 % quantile, |z| = 1.645).
+    auto cut = d.begin() + static_cast<std::ptrdiff_t>(d.size() * 9 / 10);
+    std::nth_element(d.begin(), cut, d.end());
+    double sum = 0.0;
+    for (auto it = d.begin(); it != cut; ++it) sum += *it;
+    const double kept = static_cast<double>(cut - d.begin());
+    return std::sqrt(sum / std::max(kept, 1.0) / (0.6231 * 20.0));
+  };
+  NoiseLevels n;
+  n.x = sigma(record_.x);
+  // The spool flow noise moves the two chamber pressures in opposite directions (a flow into
+  // one chamber is a flow out of the other), so it shows in each pressure's third differences
+  // but largely cancels in p1 + p2, where the two transducers' independent noises add: the
+  // pressure transducers' noise is read there (both taken as equal).
+  std::vector<double> sum(record_.size());
+  for (std::size_t k = 0; k < sum.size(); ++k) sum[k] = record_.p1[k] + record_.p2[k];
+  n.p1 = n.p2 = sigma(sum) / std::sqrt(2.0);
+  n.spool_sigma = rig_.sigma_w;
+  n.spool_tau = rig_.tau_w;
+  return n;
+}
+
+std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& parameters,
+                                                    std::span<const Segment> segments,
+                                                    const NoiseLevels& noise, std::uint64_t seed,
+                                                    int repeats) const {
+  const ActuatorModel model(parameters, rig_);
+  const std::vector<double> xs = spool_positions(model);
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> normal;
+  // The flow noise is an Ornstein-Uhlenbeck process; over a sample the plant integrates its
+  // mean, whose variance and correlation with the next sample's mean follow from tau_w / dt.
+  const double a = noise.spool_tau / record_.dt;
+  const double e = std::exp(-1.0 / a);
+  const double mean_var = noise.spool_sigma * noise.spool_sigma * 2.0 * a * (1.0 - a * (1.0 - e));
+  const double next_cov = noise.spool_sigma * noise.spool_sigma * a * a * (1.0 - e) * (1.0 - e);
+  const double rho = mean_var > 0.0 ? std::clamp(next_cov / mean_var, 0.0, 0.99) : 0.0;
+  const double w_sigma = std::sqrt(std::max(mean_var, 0.0));
+  const double w_innovation = w_sigma * std::sqrt(1.0 - rho * rho);
+  // The +-3-sample velocity line's noise from the position noise.
+  double weight = 0.0;
+  for (int i = 1; i <= kVelocityHalfWindow; ++i) weight += 2.0 * i * i;
+  const double v_sigma = noise.x / (std::sqrt(weight) * record_.dt);
+  const double sigmas[3] = {noise.x, noise.p1, noise.p2};
+  const std::vector<double>* measured[3] = {&record_.x, &record_.p1, &record_.p2};
+  double err2[3] = {0.0, 0.0, 0.0};
+  std::size_t n = 0;
+  for (int r = 0; r < repeats; ++r) {
+    for (const auto& seg : segments) {
+      const std::size_t k0 = seg.begin;
+      ActuatorState truth;
+      truth.xs = xs[k0];
+      truth.x = record_.x[k0];
+      truth.v = velocity_[k0];
+      truth.p1 = record_.p1[k0];
+      truth.p2 = record_.p2[k0];
+      truth.s = truth.p1;
+      ActuatorState guess = truth;
+      guess.x += noise.x * normal(random);
+      guess.v += v_sigma * normal(random);
+      guess.p1 += noise.p1 * normal(random);
+      guess.p2 += noise.p2 * normal(random);
+      double w = w_sigma * normal(random);
+      for (std::size_t j = 1; j < seg.length; ++j) {
+        const std::size_t k = k0 + j;
+        model.advance(truth, record_.u[k - 1], record_.t[k - 1], record_.dt, w);
+        model.advance(guess, record_.u[k - 1], record_.t[k - 1], record_.dt);
+        w = rho * w + w_innovation * normal(random);
+        const Reading t = model.read(truth);
+        const Reading g = model.read(guess);
+        const double truth_read[3] = {t.x, t.p1, t.p2};
+        const double guess_read[3] = {g.x, g.p1, g.p2};
+        for (int c = 0; c < 3; ++c) {
+          const double d = guess_read[c] - truth_read[c] - sigmas[c] * normal(random);
+          if (std::isfinite(d)) err2[c] += d * d;
+        }
+        ++n;
+      }
+    }
+  }
+  std::array<double, 3> out{};
+  if (n == 0) return out;
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0.0, sum2 = 0.0;
+    std::size_t m = 0;
+    for (const auto& seg : segments) {
+      for (std::size_t k = seg.begin + 1; k < seg.begin + seg.length; ++k) {
+        const double y = (*measured[c])[k];
+        sum += y;
+        sum2 += y * y;
+        ++m;
+      }
+    }
+    const double mean = sum / static_cast<double>(m);
+    const double var = std::max(sum2 / static_cast<double>(m) - mean * mean, 1e-30);
+    out[static_cast<std::size_t>(c)] = std::sqrt(err2[c] / static_cast<double>(n) / var);
+  }
+  return out;
 }
 
 double SegmentPredictor::nrmse(const ModelParameters& parameters,

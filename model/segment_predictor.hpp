@@ -7,7 +7,9 @@
 // on the segment errors: multiple shooting) and scoring (NRMSE on held-out segments).
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -47,6 +49,14 @@ struct ChannelScales {
   double x = 1.0, p1 = 1.0, p2 = 1.0;
 };
 
+// The noise a correct model cannot predict (MODEL.md): the transducers' white noise per
+// channel [m, Pa] and the spool flow noise (std. dev. as a fraction of travel, correlation
+// time [s]).
+struct NoiseLevels {
+  double x = 0.0, p1 = 0.0, p2 = 0.0;
+  double spool_sigma = 0.0, spool_tau = 1e-3;
+};
+
 class SegmentPredictor {
  public:
   explicit SegmentPredictor(const MeasuredRecord& record,
@@ -67,6 +77,23 @@ class SegmentPredictor {
   // p2, on the given segments.
   double nrmse(const ModelParameters& parameters, std::span<const Segment> segments) const;
   double nrmse(const Prediction& prediction, std::span<const Segment> segments) const;
+  // The same per channel: x, p1, p2.
+  std::array<double, 3> channel_nrmse(const Prediction& prediction,
+                                      std::span<const Segment> segments) const;
+
+  // The transducers' white-noise std. dev. per channel, read off the record: the robust
+  // spread (median absolute value) of third differences, which white noise inflates by
+  // sqrt(20) while the plant's smooth motion barely shows in them at 500 Hz. The spool flow
+  // noise is the rig table's (it is not separable from the data at the sample level).
+  NoiseLevels noise_levels() const;
+  // The held-out NRMSE that the noise alone leaves (FORMATS.md `nrmse_floor`): `parameters`
+  // simulated from each segment's start with the spool flow noise drawn, read through the
+  // transducer noise, against the same model's deterministic prediction from a start read
+  // through that noise, i.e. what a correct model scores. Averaged over `repeats` draws. Per
+  // channel (x, p1, p2); FORMATS.md's value is their mean, as for nrmse.
+  std::array<double, 3> noise_floor(const ModelParameters& parameters,
+                                    std::span<const Segment> segments, const NoiseLevels& noise,
+                                    std::uint64_t seed, int repeats = 3) const;
 
  private:
   std::vector<double> spool_positions(const ActuatorModel& model) const;

@@ -54,45 +54,118 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
   s.params.b *= draw.uniform(0.7, 1.3);
 
   auto& e = s.effects;
-  const auto set_main = [&](const char* name, double value) {
-    c.main_parameter = name;
-    c.main_value = value;
-    return value;
+  // The main parameter's value: drawn within MODEL.md's range, or (settings.edge > 0) at its
+  // low end divided by `edge` or its high end times `edge`.
+  const auto in_range = [&](double lo, double hi, bool log) {
+    if (settings.edge > 0.0) return draw.coin() ? hi * settings.edge : lo / settings.edge;
+    return log ? draw.log_uniform(lo, hi) : draw.uniform(lo, hi);
   };
   const auto channel = [&] {
     return draw.coin() ? sim::PressureChannel::p1 : sim::PressureChannel::p2;
   };
-  if (c.effect == "internal_leakage") {
-    e.internal_leakage = sim::InternalLeakage{set_main("C_L", draw.log_uniform(5e-13, 5e-12))};
-  } else if (c.effect == "external_leakage") {
-    const double ce = set_main("C_E", draw.log_uniform(1e-13, 2e-12));
-    e.external_leakage = sim::ExternalLeakage{ce, draw.coin() ? 1 : 2};
-  } else if (c.effect == "coulomb_friction") {
-    e.coulomb_friction = sim::CoulombFriction{set_main("F_C", draw.uniform(50.0, 400.0))};
-  } else if (c.effect == "entrained_air") {
-    e.entrained_air = sim::EntrainedAir{set_main("alpha", draw.log_uniform(0.02, 0.2))};
-  } else if (c.effect == "valve_overlap") {
-    e.valve_overlap = sim::ValveOverlap{set_main("d", draw.uniform(0.01, 0.05))};
-  } else if (c.effect == "valve_bias") {
-    e.valve_bias = sim::ValveBias{set_main("u0", draw.sign() * draw.uniform(0.05, 0.3))};
-  } else if (c.effect == "spool_lag") {
-    e.spool_lag = sim::SpoolLag{set_main("tau", draw.uniform(0.006, 0.015))};
-  } else if (c.effect == "supply_ripple") {
-    const double dp = set_main("dP", draw.uniform(2e5, 1e6));
-    e.supply_ripple = sim::SupplyRipple{dp, draw.uniform(20.0, 200.0)};
-  } else if (c.effect == "supply_droop") {
-    e.supply_droop = sim::SupplyDroop{set_main("R_s", draw.log_uniform(5e9, 3e10))};
-  } else if (c.effect == "sensor_offset") {
-    const double offset = set_main("offset", draw.sign() * draw.uniform(5e4, 3e5));
-    e.sensor_offset = sim::SensorOffset{offset, channel()};
-  } else if (c.effect == "sensor_lag") {
-    e.sensor_lag = sim::SensorLag{set_main("tau_s", draw.uniform(0.002, 0.01)), channel()};
-  } else if (c.effect != "none") {
-    throw std::invalid_argument(fmt::format("unknown effect '{}'", c.effect));
+  // "a+b": several effects at once, each drawn in turn; the first one is the case's main.
+  std::vector<std::string> parts;
+  for (std::size_t begin = 0; begin <= c.effect.size();) {
+    const std::size_t end = std::min(c.effect.find('+', begin), c.effect.size());
+    parts.push_back(c.effect.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  for (const auto& part : parts) {
+    TrueEffect t{part, "", 0.0};
+    const auto set_main = [&](const char* name, double value) {
+      t.main_parameter = name;
+      t.main_value = value;
+      return value;
+    };
+    if (part == "internal_leakage") {
+      e.internal_leakage = sim::InternalLeakage{set_main("C_L", in_range(5e-13, 5e-12, true))};
+    } else if (part == "external_leakage") {
+      const double ce = set_main("C_E", in_range(1e-13, 2e-12, true));
+      e.external_leakage = sim::ExternalLeakage{ce, draw.coin() ? 1 : 2};
+    } else if (part == "coulomb_friction") {
+      e.coulomb_friction = sim::CoulombFriction{set_main("F_C", in_range(50.0, 400.0, false))};
+    } else if (part == "entrained_air") {
+      e.entrained_air = sim::EntrainedAir{set_main("alpha", in_range(0.02, 0.2, true))};
+    } else if (part == "valve_overlap") {
+      e.valve_overlap = sim::ValveOverlap{set_main("d", in_range(0.01, 0.05, false))};
+    } else if (part == "valve_bias") {
+      e.valve_bias = sim::ValveBias{set_main("u0", draw.sign() * in_range(0.05, 0.3, false))};
+    } else if (part == "spool_lag") {
+      e.spool_lag = sim::SpoolLag{set_main("tau", in_range(0.006, 0.015, false))};
+    } else if (part == "supply_ripple") {
+      const double dp = set_main("dP", in_range(2e5, 1e6, false));
+      e.supply_ripple = sim::SupplyRipple{dp, draw.uniform(20.0, 200.0)};
+    } else if (part == "supply_droop") {
+      e.supply_droop = sim::SupplyDroop{set_main("R_s", in_range(5e9, 3e10, true))};
+    } else if (part == "sensor_offset") {
+      const double offset = set_main("offset", draw.sign() * in_range(5e4, 3e5, false));
+      e.sensor_offset = sim::SensorOffset{offset, channel()};
+    } else if (part == "sensor_lag") {
+      e.sensor_lag = sim::SensorLag{set_main("tau_s", in_range(0.002, 0.01, false)), channel()};
+    } else if (part == "oil_temperature") {
+      // A warm-up within the capture (MODEL.md "Drifting operating conditions"): from a cold
+      // start towards the working temperature, in one of the three oils of its table.
+      const int grades[] = {32, 46, 68};
+      s.conditions.oil = *sim::Oil::iso_vg(grades[draw.index(3)]);
+      sim::TemperatureProfile warm_up;
+      warm_up.kind = sim::TemperatureProfile::Kind::warm_up;
+      warm_up.T0 = draw.uniform(15.0, 28.0);
+      warm_up.T_work = draw.uniform(40.0, 50.0);
+      warm_up.tau_s = settings.duration_s * draw.uniform(0.3, 1.0);
+      warm_up.start_s = 0.0;
+      s.conditions.temperature = warm_up;
+      s.record.temp = settings.record_temperature;
+      set_main("visc_slope", s.conditions.oil.viscosity_slope(sim::kReferenceTemperature));
+    } else if (part != "none") {
+      throw std::invalid_argument(fmt::format("unknown effect '{}'", part));
+    }
+    if (part != "none") c.effects.push_back(t);
+  }
+  if (!c.effects.empty()) {
+    c.main_parameter = c.effects.front().main_parameter;
+    c.main_value = c.effects.front().main_value;
   }
   return c;
 }
 
 capture::Capture simulate_case(const SyntheticCase& c) { return sim::simulate(c.scenario); }
+
+ModelParameters true_model(const SyntheticCase& c) {
+  const auto& s = c.scenario;
+  ModelParameters m;
+  m.calibration = {s.params.beta, s.params.Kv, s.params.m, s.params.b};
+  const auto& e = s.effects;
+  auto& t = m.effects;
+  const auto channel = [](sim::PressureChannel ch) {
+    return ch == sim::PressureChannel::p1 ? PressureChannel::p1 : PressureChannel::p2;
+  };
+  if (e.internal_leakage) t.C_L = e.internal_leakage->C_L;
+  if (e.external_leakage) {
+    t.C_E = e.external_leakage->C_E;
+    t.external_chamber = e.external_leakage->chamber;
+  }
+  if (e.coulomb_friction) t.F_C = e.coulomb_friction->F_C;
+  if (e.entrained_air) t.alpha = e.entrained_air->alpha;
+  if (e.valve_overlap) t.d = e.valve_overlap->d;
+  if (e.valve_bias) t.u0 = e.valve_bias->u0;
+  if (e.spool_lag) t.spool_tau = e.spool_lag->tau;
+  if (e.supply_ripple) {
+    t.ripple_dP = e.supply_ripple->dP;
+    t.ripple_f = e.supply_ripple->f;
+  }
+  if (e.supply_droop) t.R_s = e.supply_droop->R_s;
+  if (e.sensor_offset) {
+    t.offset = e.sensor_offset->offset;
+    t.offset_channel = channel(e.sensor_offset->channel);
+  }
+  if (e.sensor_lag) {
+    t.tau_s = e.sensor_lag->tau_s;
+    t.lag_channel = channel(e.sensor_lag->channel);
+  }
+  if (s.conditions.temperature) {
+    t.visc_slope = s.conditions.oil.viscosity_slope(sim::kReferenceTemperature);
+  }
+  return m;
+}
 
 }  // namespace leakmon::model

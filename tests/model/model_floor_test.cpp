@@ -1,0 +1,141 @@
+// Issue 12's building blocks that need no fitting: the noise floor read off a capture, the
+// calibration-bound flags and the joint candidate of the forward selection. Fresh seeds per
+// run (printed; LEAKMON_TEST_SEED forces one).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+#include "model/calibration_fit.hpp"
+#include "model/effect_library.hpp"
+#include "model/misfit.hpp"
+#include "model/segment_predictor.hpp"
+#include "model/synthetic_case.hpp"
+#include "tests/model/test_seed.hpp"
+
+namespace leakmon::model {
+namespace {
+
+CaseSettings short_case() {
+  CaseSettings s;
+  s.duration_s = 24.0;
+  return s;
+}
+
+// MODEL.md's transducers: pressure noise 5 kPa on a 5 kPa LSB, position noise 5 um on a 10 um
+// resolution; the quantisation adds LSB^2 / 12 to the variance. The estimate must find them
+// on a capture whose plant moves (third differences of the motion are small but not zero).
+TEST(NoiseFloor, ReadsTheTransducerNoiseOffTheCapture) {
+  const auto seed = test::model_test_seed("NoiseFloor/transducers");
+  const MeasuredRecord record =
+      measured_record(simulate_case(draw_case(seed, "none", short_case())));
+  const SegmentPredictor predictor(record);
+  const NoiseLevels n = predictor.noise_levels();
+  std::printf("noise x %.3g m, p1 %.4g Pa, p2 %.4g Pa\n", n.x, n.p1, n.p2);
+  const double p_expected = std::sqrt(5e3 * 5e3 + 5e3 * 5e3 / 12.0);
+  const double x_expected = std::sqrt(5e-6 * 5e-6 + 1e-5 * 1e-5 / 12.0);
+  EXPECT_NEAR(n.p1, p_expected, 0.2 * p_expected);
+  EXPECT_NEAR(n.p2, p_expected, 0.2 * p_expected);
+  EXPECT_NEAR(n.x, x_expected, 0.3 * x_expected);
+}
+
+// The floor must be what a correct model scores: the generator's own model on the held-out
+// segments of clean and faulty captures, against the floor estimated with that model. One
+// held-out NRMSE is itself a noisy number (a few segments mispredicted even by the true
+// model, docs/model-check.md), hence the band.
+TEST(NoiseFloor, IsWhatTheTrueModelScores) {
+  for (const char* effect : {"none", "internal_leakage", "spool_lag"}) {
+    const auto seed = test::model_test_seed(effect);
+    const SyntheticCase c = draw_case(seed, effect, short_case());
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const SegmentPredictor predictor(record);
+    const auto plan = split_record(record);
+    const ModelParameters truth = true_model(c);
+    const double achieved = predictor.nrmse(truth, plan.held_out);
+    const auto floor = predictor.noise_floor(truth, plan.held_out, predictor.noise_levels(), seed);
+    const double mean_floor = (floor[0] + floor[1] + floor[2]) / 3.0;
+    std::printf("%s: true model's held-out NRMSE %.5f, floor %.5f (x %.5f p1 %.5f p2 %.5f)\n",
+                effect, achieved, mean_floor, floor[0], floor[1], floor[2]);
+    EXPECT_GT(mean_floor, 0.6 * achieved) << effect;
+    EXPECT_LT(mean_floor, 1.4 * achieved) << effect;
+  }
+}
+
+// A misfit is located where it was put: a wrong Kv on clean data shows in the pressures or
+// the position, and its rate follows a regressor; a leak the model lacks follows the load
+// pressure (MODEL.md's signature) more than time.
+// Three fresh captures (seeds first .. first + 2; LEAKMON_TEST_SEED=first reproduces the run):
+// the residual's rate follows the leak term only as far as the open-loop dynamics let it (a
+// pressure error moves the piston, which moves the pressures again), and in about one capture
+// in 30 the load pressure was not among the two leading regressors (seed 18301707822665037876:
+// velocity_sign +0.23, dp_dt -0.13, load_pressure -0.05 in p2). So per run: the misfit never in
+// x and time never leading, and the load pressure among the two leading in two of three.
+TEST(Misfit, FollowsTheLoadPressureForAMissingLeak) {
+  const auto first = test::model_test_seed("Misfit/leak (first of 3)");
+  int leading = 0;
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    const std::uint64_t seed = first + k;
+    CaseSettings s = short_case();
+    const SyntheticCase c = draw_case(seed, "internal_leakage", s);
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const SegmentPredictor predictor(record);
+    const auto plan = split_record(record);
+    ModelParameters without_leak = true_model(c);
+    without_leak.effects.C_L = 0.0;
+    const auto floor =
+        predictor.noise_floor(true_model(c), plan.held_out, predictor.noise_levels(), seed);
+    const Misfit m = locate_misfit(predictor, without_leak, plan.held_out, floor);
+    std::printf("seed %llu: %s\n", static_cast<unsigned long long>(seed), describe(m).c_str());
+    ASSERT_GE(m.regressors.size(), 2u);
+    EXPECT_NE(m.channel, "x") << "seed " << seed;
+    EXPECT_NE(m.regressors[0].regressor, "time") << "seed " << seed;
+    // The pressure's rate error is -C_L (p1 - p2) / C_h in p1: the load pressure or its close
+    // companion, the valve opening that sets it, leads.
+    leading += m.regressors[0].regressor == "load_pressure" ||
+               m.regressors[1].regressor == "load_pressure";
+  }
+  EXPECT_GE(leading, 2) << "load pressure among the two leading regressors, of 3";
+}
+
+TEST(Calibration, FlagsValuesOnTheirBounds) {
+  Calibration c;  // the rig table's nominal values: inside every bound
+  EXPECT_TRUE(calibration_at_bound(c).empty());
+  c.beta = 1e12;  // far above; the fit clamps to the bound, which this reports
+  c.b = 0.0;
+  const auto flagged = calibration_at_bound(c);
+  ASSERT_EQ(flagged.size(), 2u);
+  EXPECT_EQ(flagged[0], "beta");
+  EXPECT_EQ(flagged[1], "b");
+  const Calibration inside = within_bounds(c);
+  EXPECT_TRUE(calibration_at_bound(inside).empty());
+  EXPECT_LT(inside.beta, 1e12);
+}
+
+TEST(EffectLibrary, JointCandidateAppliesEachPartToItsOwnParameters) {
+  const auto library = effect_library(0.0, true);
+  const EffectCandidate* leak = nullptr;
+  const EffectCandidate* lag = nullptr;
+  const EffectCandidate* oil = nullptr;
+  for (const auto& c : library) {
+    if (c.effect == "internal_leakage") leak = &c;
+    if (c.effect == "sensor_lag" && c.variant == "p2") lag = &c;
+    if (c.effect == "oil_temperature") oil = &c;
+  }
+  ASSERT_TRUE(leak && lag && oil);
+  const EffectCandidate joint = combine({*leak, *lag, *oil});
+  EXPECT_EQ(joint.effect, "internal_leakage+sensor_lag+oil_temperature");
+  ASSERT_EQ(joint.parameters.size(), 3u);
+  EffectParameters e;
+  joint.apply(e, {2e-12, 0.005, 0.046});
+  EXPECT_DOUBLE_EQ(e.C_L, 2e-12);
+  EXPECT_DOUBLE_EQ(e.tau_s, 0.005);
+  EXPECT_EQ(e.lag_channel, PressureChannel::p2);
+  EXPECT_DOUBLE_EQ(e.visc_slope, 0.046);
+  EXPECT_TRUE(joint.plausible({2e-12, 0.005, 0.046}));
+  EXPECT_FALSE(joint.plausible({-1e-12, 0.005, 0.046}));  // a negative leak is no leak
+  EXPECT_FALSE(effect_library(0.0, false).back().effect == "oil_temperature");
+}
+
+}  // namespace
+}  // namespace leakmon::model

@@ -1,0 +1,125 @@
+// Issue 12 on fresh random cases (seeds printed; LEAKMON_TEST_SEED forces one): two effects at
+// once, the oil warming up with and without the `temp` column, and an honest `none`. Each case
+// simulates and diagnoses a 60 s capture (seconds of CPU each), hence the `long` label. The
+// rates (>= 85 %, >= 90 %, >= 97 %) are what `leakmon model evaluate` measures over many cases
+// (docs/model-check.md); a run here asserts what must hold in every case, and the rest over two
+// cases so that a single unlucky draw does not fail the run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "model/diagnosis.hpp"
+#include "model/result_json.hpp"
+#include "model/synthetic_case.hpp"
+#include "tests/model/test_seed.hpp"
+
+namespace leakmon::model {
+namespace {
+
+bool named(const Diagnosis& d, const std::string& effect) {
+  return std::any_of(d.causes.begin(), d.causes.end(),
+                     [&](const NamedCause& c) { return c.effect == effect; });
+}
+
+std::string causes(const Diagnosis& d) {
+  std::string out;
+  for (const auto& c : d.causes) out += (out.empty() ? "" : "+") + c.effect;
+  return out.empty() ? d.cause : out;
+}
+
+Diagnosis run(const char* label, const std::string& effect, const CaseSettings& settings = {},
+              SyntheticCase* drawn = nullptr) {
+  const auto seed = test::model_test_seed(label);
+  const SyntheticCase c = draw_case(seed, effect, settings);
+  Diagnosis d = diagnose(measured_record(simulate_case(c)));
+  std::printf("%s: truth %s, cause %s, causes %s, nrmse %.4f -> %.4f, floor %.4f, drifts %d\n",
+              label, effect.c_str(), d.cause.c_str(), causes(d).c_str(), d.nrmse_before,
+              d.nrmse_after, d.nrmse_floor, d.drifts ? 1 : 0);
+  if (drawn) *drawn = c;
+  return d;
+}
+
+TEST(SeveralEffects, BothOfAVisiblePairAreNamed) {
+  // Issue 12's two examples; only one of each pair was named before forward selection.
+  int both = 0;
+  for (const char* pair : {"sensor_lag+spool_lag", "sensor_lag+valve_overlap"}) {
+    const Diagnosis d = run(pair, pair);
+    const std::string p = pair;
+    const std::string first = p.substr(0, p.find('+')), second = p.substr(p.find('+') + 1);
+    // The stronger effect of the pair is always found, nothing outside the pair is named,
+    // and every step of the forward selection is on record.
+    EXPECT_TRUE(named(d, first) || named(d, second)) << pair;
+    for (const auto& c : d.causes) {
+      EXPECT_TRUE(c.effect == first || c.effect == second) << pair << ": " << c.effect;
+    }
+    EXPECT_GE(d.steps.size(), d.causes.size());
+    both += named(d, first) && named(d, second);
+    EXPECT_LT(d.nrmse_after, d.nrmse_before);
+  }
+  EXPECT_GE(both, 1) << "both effects named in fewer than one of two pairs";
+}
+
+TEST(Drift, WarmUpWithTemperatureIsTheOilTemperature) {
+  SyntheticCase c;
+  const Diagnosis d = run("warm-up with temp", "oil_temperature", {}, &c);
+  ASSERT_TRUE(named(d, "oil_temperature"));
+  double slope = 0.0;
+  for (const auto& cause : d.causes) {
+    if (cause.effect != "oil_temperature") continue;
+    for (const auto& p : cause.params) {
+      if (p.name == "visc_slope") slope = p.value;
+    }
+  }
+  std::printf("visc_slope true %.4f estimated %.4f\n", c.main_value, slope);
+  EXPECT_NEAR(slope, c.main_value, 0.25 * c.main_value);
+  EXPECT_FALSE(named(d, "internal_leakage"));
+}
+
+TEST(Drift, WarmUpWithoutTemperatureIsDriftNeverALeak) {
+  CaseSettings no_temp;
+  no_temp.record_temperature = false;
+  int drift = 0;
+  for (const char* label : {"warm-up without temp 1", "warm-up without temp 2"}) {
+    const Diagnosis d = run(label, "oil_temperature", no_temp);
+    // Never a constant fault that would send a crew to change seals, never "the model is right".
+    EXPECT_NE(d.cause, "internal_leakage");
+    EXPECT_FALSE(named(d, "internal_leakage"));
+    EXPECT_NE(d.cause, "none");
+    const bool reported = d.cause == "unexplained" && d.unexplained && d.unexplained->drifts;
+    drift += reported;
+    if (d.cause == "unexplained") {
+      const std::string json = diagnosis_json(d);
+      EXPECT_NE(json.find("\"unexplained\": {\"channel\""), std::string::npos);
+      EXPECT_NE(json.find("\"drifts\": true"), std::string::npos);
+    }
+  }
+  EXPECT_GE(drift, 1) << "drift reported in fewer than one of two warm-ups";
+}
+
+TEST(HonestNone, CleanDataReachesTheFloorAndIsNone) {
+  // Two clean captures: `none` is a statistical decision (a few per cent of clean captures
+  // name an effect by chance, model_diagnosis_test's HiddenEffect.CleanDataGivesNone asserts
+  // that rate with a margin), so one of the two must be `none`, and every one at its floor.
+  int nones = 0;
+  for (const char* label : {"clean 1", "clean 2"}) {
+    const Diagnosis d = run(label, "none");
+    EXPECT_GT(d.nrmse_floor, 0.0);
+    // The nominal model of clean data is right: its held-out error is at the floor (`none`
+    // needs 1.3 x; asserted with a margin).
+    EXPECT_LE(d.nrmse_before, 1.6 * d.nrmse_floor) << label;
+    if (d.cause != "none") continue;
+    ++nones;
+    EXPECT_LE(d.nrmse_before, DiagnosisSettings{}.floor_factor * d.nrmse_floor);
+    const std::string json = diagnosis_json(d);
+    EXPECT_NE(json.find("\"nrmse_floor\": "), std::string::npos);
+    EXPECT_NE(json.find("\"causes\": []"), std::string::npos);
+    EXPECT_NE(json.find("\"unexplained\": null"), std::string::npos);
+  }
+  EXPECT_GE(nones, 1) << "neither clean capture was `none`";
+}
+
+}  // namespace
+}  // namespace leakmon::model
