@@ -73,13 +73,13 @@ std::string encode_trend(const FixedRing<TrendPoint>& points) {
   std::string out = fmt::format("{}{}\n{}\n", kTrendMagic, kTrendVersion, kTrendColumns);
   for (std::size_t i = 0; i < points.size(); ++i) {
     const TrendPoint& p = points[i];
-    fmt::format_to(
-        std::back_inserter(out),
-        "{:.3f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
-        "{}\n",
-        p.unix_time, p.index_p1, p.index_p2, p.score, p.raise_threshold, p.leak_lpm_per_mpa,
-        p.leak_lpm_per_mpa_ci95, p.p1, p.p2, p.oil_temperature, p.alarm, p.learning ? 1 : 0,
-        p.suspended ? 1 : 0, p.channel_status[0], p.channel_status[1], p.channel_status[2]);
+    fmt::format_to(std::back_inserter(out),
+                   "{:.3f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
+                   "{}\n",
+                   p.unix_time, p.index_p1, p.index_p2, p.score, p.raise_threshold,
+                   p.leak_lpm_per_mpa, p.leak_lpm_per_mpa_ci95, p.p1, p.p2, p.oil_temperature,
+                   p.alarm, p.learning ? 1 : 0, p.suspended ? 1 : 0, p.channel_status[0],
+                   p.channel_status[1], p.channel_status[2]);
   }
   return out;
 }
