@@ -94,8 +94,8 @@ TEST(IndexCusumDrift, ALeakDuringOrAfterTheCoolDownIsFound) {
 // With both chambers the supply is read from p1 + p2 at rest (or a ps channel); with p1 alone
 // only a ps channel tells a lowered supply from a leak.
 TEST(IndexCusumDrift, SupplySetPointChangesAreNotALeak) {
-  for (const auto& [both, with_ps] :
-       {std::pair{true, false}, std::pair{true, true}, std::pair{false, true}}) {
+  for (const auto& [both, with_ps] : {std::pair{true, false}, std::pair{true, true},
+                                      std::pair{false, true}, std::pair{false, false}}) {
     auto detector = make(both);
     test::SyntheticRig rig;
     rig.supply = test::supply_changes;
