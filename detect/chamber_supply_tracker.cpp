@@ -105,6 +105,7 @@ void ChamberSupplyTracker::on_hold(const Hold& hold) {
   }
   // Awaiting the new level: two clusters of the holds since the step, each hold fitting them.
   // A hold that does not (the ramp's end, a second step) moves the window past it.
+  const double old_mid = mid_;
   for (;;) {
     const Clusters c = clusters_since(awaiting_since_, kStepPerSide);
     if (c.ok) {
@@ -129,6 +130,17 @@ void ChamberSupplyTracker::on_hold(const Hold& hold) {
       oldest = hold_at(age).t;
     }
     awaiting_since_ = oldest;
+  }
+  // Holds after the step that happened to fit the old clusters too moved step_time() past the
+  // step; it began after the newest hold (before it was seen) that fits the old clusters only.
+  for (std::size_t age = 0; age < count_; ++age) {
+    const Hold& h = hold_at(age);
+    if (h.t > awaiting_from_t_) continue;
+    if (h.t <= step_time_ - kGiveUpSeconds) break;
+    if (fits(h.level, old_mid) && !fits(h.level, mid_)) {
+      step_time_ = std::min(step_time_, h.t);
+      break;
+    }
   }
   awaiting_since_ = awaiting_from_t_ = kMissing;
   last_fit_t_ = hold.t;

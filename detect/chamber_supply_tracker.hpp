@@ -32,7 +32,8 @@ class ChamberSupplyTracker {
   bool active() const { return !std::isnan(learned_mid_); }
   // A step was seen and its new level is not yet known.
   bool awaiting() const { return !std::isnan(awaiting_since_); }
-  // The end of the last hold that fitted the clusters before the latest step.
+  // The latest step began after this: the end of the last hold that fitted the old clusters
+  // (when the new level is estimated, the last that fits the old clusters but not the new).
   double step_time() const { return step_time_; }
   // Mid-supply now minus mid-supply at learning [Pa]: half the supply's change.
   double mid_shift() const { return active() ? mid_ - learned_mid_ : 0.0; }

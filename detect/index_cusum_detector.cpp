@@ -39,9 +39,10 @@ constexpr double kSupplyExponent = 0.5;
 constexpr std::size_t kTrendSlopeBlocks = 20;
 constexpr std::size_t kTrendLevelBlocks = 3;
 // Judged blocks whose CUSUM increments can be taken back after a supply step seen through one
-// chamber: the step shows at the end of the first hold after it (holds last up to 4 s, a ramp
-// up to 5 s), so about 10 s; the ring covers three times that.
-constexpr std::size_t kCusumHistoryBlocks = 40;
+// chamber: the step shows at the end of the first hold that fits neither cluster (holds last up
+// to 4 s, a ramp up to 5 s, and a few holds after the step may fit by chance), so within about
+// 20 s; the ring covers 48 s.
+constexpr std::size_t kCusumHistoryBlocks = 60;
 
 }  // namespace
 
@@ -161,6 +162,8 @@ double IndexCusumDetector::supply_from_chamber(const Observation& o, double load
       trend_count_ = trend_next_ = 0;
       break;
     case ChamberSupplyTracker::Event::estimated: {
+      // Nothing was judged while waiting; the step may have begun earlier than first thought.
+      take_back_cusum_after(chamber_supply_.step_time());
       // ps + pt = 2 mid: the supply moved by twice mid-supply's shift since learning.
       const double learned = std::isnan(learned_supply_) ? configured : learned_supply_;
       supply_estimate_ = supply_anchor_ =
@@ -183,7 +186,6 @@ void IndexCusumDetector::take_back_cusum_after(double t) {
     if (e.t > t && (first == nullptr || e.t < first->t)) first = &e;
   }
   if (first != nullptr) cusum_.restore(first->before);
-  cusum_next_ = cusum_count_ = 0;
 }
 
 double IndexCusumDetector::expected_log_index(const Block& b) const {
