@@ -36,6 +36,11 @@ constexpr double kSupplyMemorySeconds = 2.0;
 // (but at least kTrendLevelBlocks) it uses their level.
 constexpr std::size_t kTrendSlopeBlocks = 20;
 constexpr std::size_t kTrendLevelBlocks = 3;
+// Judged blocks whose CUSUM increments can be taken back after a supply step seen through one
+// chamber: the step shows at the end of the first hold that fits neither cluster (holds last up
+// to 4 s, a ramp up to 5 s, and a few holds after the step may fit by chance), so within about
+// 20 s; the ring covers 48 s.
+constexpr std::size_t kCusumHistoryBlocks = 60;
 
 }  // namespace
 
@@ -45,8 +50,10 @@ IndexCusumDetector::IndexCusumDetector(const IndexCusumOptions& options, double 
       learn_hops_(std::max<std::size_t>(options.learning.learn_hops(hop_seconds), 1)),
       block_hops_(std::max<std::size_t>(
           static_cast<std::size_t>(std::lround(options.block_seconds / hop_seconds)), 1)),
+      one_chamber_(options.use_p1 != options.use_p2),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)) {
   learned_.reserve(learn_hops_ / block_hops_ + 1);
+  cusum_history_.resize(kCusumHistoryBlocks);
   const double trend_seconds = options.drift_guard_seconds + options.drift_window_seconds +
                                options.supply_settle_seconds + options.block_seconds;
   trend_.resize(static_cast<std::size_t>(std::ceil(trend_seconds / options.block_seconds)) + 2);
@@ -67,6 +74,9 @@ void IndexCusumDetector::reset() {
   temperature_seen_ = false;
   supply_estimate_ = supply_anchor_ = supply_step_since_ = kMissing;
   supply_off_hops_ = 0;
+  chamber_supply_.reset();
+  learned_supply_ = kMissing;
+  cusum_next_ = cusum_count_ = 0;
   cusum_.reset();
   trend_next_ = trend_count_ = 0;
 }
@@ -101,6 +111,7 @@ double IndexCusumDetector::load_of(const Observation& o, double ps) const {
 // before it belongs to another supply).
 double IndexCusumDetector::supply_for(const Observation& o, double load) {
   const double configured = options_.rig.ps;
+  if (one_chamber_ && std::isnan(o.ps)) return supply_from_chamber(o, load);
   double reading = kMissing;
   bool direct = false;
   if (!std::isnan(o.ps)) {
@@ -137,6 +148,44 @@ double IndexCusumDetector::supply_for(const Observation& o, double load) {
   return supply_estimate_;
 }
 
+// One chamber's hold levels (ChamberSupplyTracker). The blocks judged after a step began were
+// judged against the old supply: their CUSUM increments are taken back.
+double IndexCusumDetector::supply_from_chamber(const Observation& o, double load) {
+  const double configured = options_.rig.ps;
+  const bool still = std::abs(load - previous_rough_load_) < kRestActivity;  // false with a NaN
+  previous_rough_load_ = load;
+  switch (chamber_supply_.add(o.t, options_.use_p1 ? o.p1 : o.p2, still)) {
+    case ChamberSupplyTracker::Event::step:
+      take_back_cusum_after(chamber_supply_.step_time());
+      trend_count_ = trend_next_ = 0;
+      break;
+    case ChamberSupplyTracker::Event::estimated: {
+      // Nothing was judged while waiting; the step may have begun earlier than first thought.
+      take_back_cusum_after(chamber_supply_.step_time());
+      // ps + pt = 2 mid: the supply moved by twice mid-supply's shift since learning.
+      const double learned = std::isnan(learned_supply_) ? configured : learned_supply_;
+      supply_estimate_ = supply_anchor_ =
+          std::max(learned + 2.0 * chamber_supply_.mid_shift(), 0.1 * configured);
+      supply_step_since_ = o.t;
+      trend_count_ = trend_next_ = 0;
+      break;
+    }
+    case ChamberSupplyTracker::Event::none:
+      break;
+  }
+  return std::isnan(supply_estimate_) ? configured : supply_estimate_;
+}
+
+void IndexCusumDetector::take_back_cusum_after(double t) {
+  // The oldest remembered block after t (the ring's oldest if all are): the CUSUM before it.
+  const CusumEntry* first = nullptr;
+  for (std::size_t i = 0; i < cusum_count_; ++i) {
+    const CusumEntry& e = cusum_history_[i];
+    if (e.t > t && (first == nullptr || e.t < first->t)) first = &e;
+  }
+  if (first != nullptr) cusum_.restore(first->before);
+}
+
 double IndexCusumDetector::expected_log_index(const Block& b) const {
   return coefficients_[0] + coefficients_[1] * b.load + coefficients_[2] * b.load_squared +
          coefficients_[3] * b.log_activity + coefficients_[4] * b.log_friction +
@@ -149,7 +198,8 @@ bool IndexCusumDetector::add_to_block(const Observation& o, double log_index, do
   const double activity = std::abs(load - previous_load_);
   previous_load_ = load;
   const bool settled =
-      std::isnan(supply_step_since_) || o.t - supply_step_since_ >= kSupplyTransientSeconds;
+      (std::isnan(supply_step_since_) || o.t - supply_step_since_ >= kSupplyTransientSeconds) &&
+      !chamber_supply_.awaiting();
   const bool temperature_ok = !temperature_seen_ || !std::isnan(o.temp);
   if (!std::isnan(log_index) && !std::isnan(activity) && settled && temperature_ok) {
     sum_log_index_ += log_index;
@@ -182,6 +232,8 @@ bool IndexCusumDetector::add_to_block(const Observation& o, double log_index, do
 
 void IndexCusumDetector::finish_learning() {
   learned_model_ = true;
+  learned_supply_ = std::isnan(supply_estimate_) ? options_.rig.ps : supply_estimate_;
+  if (one_chamber_) chamber_supply_.learn();
   if (learned_.size() < 2 * kRegressors) return;  // too little data: never judges
   // The supply's share is physical (supply_exponent), not learned: the learning period rarely
   // sees more than one supply.
@@ -320,7 +372,7 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   }
   decision.learning = false;
   if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) return decision;
-  if (completed) {
+  if (completed && !chamber_supply_.awaiting()) {
     const double residual = block.log_index - expected_log_index(block);
     const double reference = drift_reference(block.t);
     last_expected_ = expected_log_index(block) + reference;
@@ -334,6 +386,9 @@ Decision IndexCusumDetector::update(const Observation& observation) {
       const double null_shift = std::log1p(-options_.min_drop) / block_sigma_;
       const double shift = std::log1p(-options_.design_drop) / block_sigma_;  // more negative
       const double z = (residual - reference) / block_sigma_;
+      cusum_history_[cusum_next_] = {block.t, cusum_.value()};
+      cusum_next_ = (cusum_next_ + 1) % cusum_history_.size();
+      cusum_count_ = std::min(cusum_count_ + 1, cusum_history_.size());
       cusum_.add((shift - null_shift) * (z - (shift + null_shift) / 2.0));
       // Blocks under suspicion stay out of the reference: a leak is never learned as drift.
       if (cusum_.normalised() < 0.5) remember_block(block.t, residual);
@@ -349,7 +404,8 @@ Decision IndexCusumDetector::update(const Observation& observation) {
 namespace leakmon::detect {
 
 namespace {
-constexpr int kIndexStateVersion = 2;  // 2: drift reference, temperature, supply
+constexpr int kIndexStateVersion =
+    3;  // 2: drift reference, temperature, supply; 3: one chamber's supply
 constexpr std::size_t kBlockValues = 7;
 }  // namespace
 
@@ -385,6 +441,14 @@ DetectorState IndexCusumDetector::export_state() const {
   state.put("trend", trend);
   state.put_count("trend_next", trend_next_);
   state.put_count("trend_count", trend_count_);
+  state.put("chamber_supply", chamber_supply_.export_values());
+  state.put("learned_supply", learned_supply_);
+  std::vector<double> history;
+  history.reserve(cusum_history_.size() * 2);
+  for (const auto& e : cusum_history_) history.insert(history.end(), {e.t, e.before});
+  state.put("cusum_history", history);
+  state.put_count("cusum_next", cusum_next_);
+  state.put_count("cusum_count", cusum_count_);
   return state;
 }
 
@@ -447,6 +511,19 @@ void IndexCusumDetector::import_state(const DetectorState& state) {
     for (std::size_t i = 0; i < trend_.size(); ++i) trend_[i] = {trend[2 * i], trend[2 * i + 1]};
     trend_next_ = trend_next;
     trend_count_ = trend_count;
+    chamber_supply_.import_values(state.get_list("chamber_supply"));
+    learned_supply_ = state.get("learned_supply");
+    const auto& history = list("cusum_history", cusum_history_.size() * 2);
+    const std::size_t cusum_next = state.get_count("cusum_next");
+    const std::size_t cusum_count = state.get_count("cusum_count");
+    if (cusum_next >= cusum_history_.size() || cusum_count > cusum_history_.size()) {
+      throw StateError("index_cusum: CUSUM history position out of range");
+    }
+    for (std::size_t i = 0; i < cusum_history_.size(); ++i) {
+      cusum_history_[i] = {history[2 * i], history[2 * i + 1]};
+    }
+    cusum_next_ = cusum_next;
+    cusum_count_ = cusum_count;
   } catch (...) {
     reset();
     throw;
@@ -460,6 +537,8 @@ void IndexCusumDetector::resume_after_gap() {
   supply_step_since_ = kMissing;
   supply_off_hops_ = 0;
   previous_load_ = previous_rough_load_ = kMissing;
+  chamber_supply_.resume_after_gap();
+  cusum_next_ = cusum_count_ = 0;
 }
 
 }  // namespace leakmon::detect

@@ -16,6 +16,11 @@
 //   rest; the load is normalised by it and the log-index shifted by 0.5 ln(ps). After a step of
 //   the supply the detector does not judge for a while and re-anchors its reference on the
 //   blocks after the step.
+// - With one chamber and no `ps` the supply is read from that chamber's hold levels
+//   (ChamberSupplyTracker): at rest it sits at (ps + pt) / 2 +- the spring load's half, two
+//   clusters mirrored around mid-supply. A hold that fits neither is a supply step: the blocks
+//   judged since the step began are taken back out of the CUSUM, and the detector does not
+//   judge until the holds after the step give the new supply, then re-anchors as above.
 // - What is left of slow drift (the oil without a `temp` observation, or a rig whose temperature
 //   law differs from the prior) is followed: the reference is a trend fitted to the residuals
 //   of a window that ends `drift_guard_seconds` ago, and blocks are kept out of it while the
@@ -27,6 +32,7 @@
 #include <string_view>
 #include <vector>
 
+#include "detect/chamber_supply_tracker.hpp"
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
 #include "detect/learning_schedule.hpp"
@@ -92,6 +98,7 @@ class IndexCusumDetector final : public Detector {
   bool add_to_block(const Observation& o, double log_index, double load, double supply,
                     Block& completed);
   double supply_for(const Observation& o, double load);
+  double supply_from_chamber(const Observation& o, double load);
   void finish_learning();
   struct TrendBlock {
     double t, residual;
@@ -120,6 +127,16 @@ class IndexCusumDetector final : public Detector {
   double supply_anchor_ = kMissing;      // the supply at the last (re-)anchoring
   double supply_step_since_ = kMissing;  // t of the last supply step
   std::size_t supply_off_hops_ = 0;      // consecutive rest readings away from the estimate
+  bool one_chamber_ = false;             // p1 or p2 alone: the supply from its hold levels
+  ChamberSupplyTracker chamber_supply_;
+  double learned_supply_ = kMissing;  // the supply the learning period's blocks were formed with
+  // The CUSUM before each recent judged block, to take back the blocks after a supply step.
+  struct CusumEntry {
+    double t, before;
+  };
+  std::vector<CusumEntry> cusum_history_;  // ring (capacity reserved at construction)
+  std::size_t cusum_next_ = 0, cusum_count_ = 0;
+  void take_back_cusum_after(double t);
   Cusum cusum_;
   // Residuals for the drift reference, a ring (capacity reserved at construction).
   std::vector<TrendBlock> trend_;
