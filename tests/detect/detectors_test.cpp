@@ -18,10 +18,10 @@ constexpr AvailableSignals kPressuresOnly{true, true, false, false};
 
 TEST(DetectorFactory, DefaultDependsOnAcquiredChannels) {
   EXPECT_EQ(default_detector_kind(kAll), "flow_balance");
-  EXPECT_EQ(default_detector_kind(kPressuresOnly), "index_cusum");
+  EXPECT_EQ(default_detector_kind(kPressuresOnly), "detail_xcorr");
   EXPECT_EQ(default_detector_kind(AvailableSignals{true, false, false, false}), "index_cusum");
   EXPECT_EQ(make_detector("default", kAll, 0.04, nullptr)->name(), "flow_balance");
-  EXPECT_EQ(make_detector("default", kPressuresOnly, 0.04, nullptr)->name(), "index_cusum");
+  EXPECT_EQ(make_detector("default", kPressuresOnly, 0.04, nullptr)->name(), "detail_xcorr");
   for (const auto& kind : detector_kinds()) {
     EXPECT_NE(make_detector(kind, kAll, 0.04, nullptr), nullptr) << kind;
   }
