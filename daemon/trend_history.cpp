@@ -1,11 +1,13 @@
 #include "daemon/trend_history.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 
@@ -40,10 +42,26 @@ TrendPoint point_of(double unix_time, const ActuatorStatus& a) {
 
 constexpr std::string_view kTrendMagic = "# leakmon trend ";
 constexpr int kTrendVersion = 1;
-constexpr std::string_view kTrendColumns =
-    "unix_time,index_p1,index_p2,score,raise_threshold,leak_lpm_per_mpa,leak_lpm_per_mpa_ci95,"
-    "p1,p2,oil_temperature,alarm,learning,suspended,channel_1,channel_2,channel_3";
-constexpr std::size_t kTrendFields = 16;
+// The file's columns, in order: its header line and the fields a bad row's error names.
+constexpr std::string_view kTrendColumns[] = {"unix_time",
+                                              "index_p1",
+                                              "index_p2",
+                                              "score",
+                                              "raise_threshold",
+                                              "leak_lpm_per_mpa",
+                                              "leak_lpm_per_mpa_ci95",
+                                              "p1",
+                                              "p2",
+                                              "oil_temperature",
+                                              "alarm",
+                                              "learning",
+                                              "suspended",
+                                              "channel_1",
+                                              "channel_2",
+                                              "channel_3"};
+constexpr std::size_t kTrendFields = std::size(kTrendColumns);
+
+std::string trend_header() { return fmt::format("{}", fmt::join(kTrendColumns, ",")); }
 
 double parse_number(std::string_view field, std::size_t line, std::string_view column) {
   const std::string text(field);
@@ -70,7 +88,7 @@ std::uint8_t parse_small(std::string_view field, std::size_t line, std::string_v
 }  // namespace
 
 std::string encode_trend(const FixedRing<TrendPoint>& points) {
-  std::string out = fmt::format("{}{}\n{}\n", kTrendMagic, kTrendVersion, kTrendColumns);
+  std::string out = fmt::format("{}{}\n{}\n", kTrendMagic, kTrendVersion, trend_header());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const TrendPoint& p = points[i];
     fmt::format_to(std::back_inserter(out),
@@ -88,22 +106,7 @@ std::vector<TrendPoint> decode_trend(std::string_view text) {
   std::vector<TrendPoint> points;
   std::size_t line_number = 0;
   std::vector<std::string_view> fields;
-  static constexpr std::string_view kNames[kTrendFields] = {"unix_time",
-                                                            "index_p1",
-                                                            "index_p2",
-                                                            "score",
-                                                            "raise_threshold",
-                                                            "leak_lpm_per_mpa",
-                                                            "leak_lpm_per_mpa_ci95",
-                                                            "p1",
-                                                            "p2",
-                                                            "oil_temperature",
-                                                            "alarm",
-                                                            "learning",
-                                                            "suspended",
-                                                            "channel_1",
-                                                            "channel_2",
-                                                            "channel_3"};
+  const std::string header = trend_header();
   while (!text.empty()) {
     const std::size_t end = text.find('\n');
     const std::string_view line = text.substr(0, end);
@@ -121,7 +124,7 @@ std::vector<TrendPoint> decode_trend(std::string_view text) {
       continue;
     }
     if (line_number == 2) {
-      if (line != kTrendColumns) throw std::runtime_error("line 2: unexpected columns");
+      if (line != header) throw std::runtime_error("line 2: unexpected columns");
       continue;
     }
     if (line.empty()) continue;
@@ -151,16 +154,16 @@ std::vector<TrendPoint> decode_trend(std::string_view text) {
                          &p.p2,
                          &p.oil_temperature};
     for (std::size_t k = 0; k < std::size(numbers); ++k) {
-      *numbers[k] = parse_number(fields[k], line_number, kNames[k]);
+      *numbers[k] = parse_number(fields[k], line_number, kTrendColumns[k]);
     }
     if (!std::isfinite(p.unix_time)) {
       throw std::runtime_error(fmt::format("line {}, field unix_time: not finite", line_number));
     }
-    p.alarm = parse_small(fields[10], line_number, kNames[10], 3);
-    p.learning = parse_small(fields[11], line_number, kNames[11], 1) == 1;
-    p.suspended = parse_small(fields[12], line_number, kNames[12], 1) == 1;
+    p.alarm = parse_small(fields[10], line_number, kTrendColumns[10], 3);
+    p.learning = parse_small(fields[11], line_number, kTrendColumns[11], 1) == 1;
+    p.suspended = parse_small(fields[12], line_number, kTrendColumns[12], 1) == 1;
     for (std::size_t k = 0; k < 3; ++k) {
-      p.channel_status[k] = parse_small(fields[13 + k], line_number, kNames[13 + k], 255);
+      p.channel_status[k] = parse_small(fields[13 + k], line_number, kTrendColumns[13 + k], 255);
     }
     if (!points.empty() && !(p.unix_time > points.back().unix_time)) {
       throw std::runtime_error(
