@@ -188,10 +188,11 @@ void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPubl
     // Every channel missing at once is the acquisition (a driver disconnected, missed cycles),
     // not a transducer: the daemon reports it as driver_fault. The leak decision is held all
     // the same; only a transducer's own dropout is a sensor_fault. A dropout that began in an
-    // outage stays unannounced until it has cleared.
+    // outage stays unannounced until it has cleared, whatever the channel had announced before
+    // (spikes from a damaged stream just before a link dies are still not a dead transducer).
     if (fault != detect::SensorFault::dropout) channel.in_outage = false;
     if (outage && fault == detect::SensorFault::dropout &&
-        channel.announced == detect::SensorFault::none) {
+        channel.announced != detect::SensorFault::dropout) {
       channel.in_outage = true;
     }
     if (channel.in_outage || fault == channel.announced) continue;

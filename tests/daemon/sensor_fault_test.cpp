@@ -142,6 +142,24 @@ TEST(SensorFaultReplay, AnOutageOfEveryChannelIsNotASensorFaultButOneMissingChan
   EXPECT_TRUE(events_of(single, io::EventKind::alarm_raised, "internal_leakage").empty());
 }
 
+// A flaky link: the stream is damaged (a spike is named on p1), then the link dies. The outage is
+// still the acquisition's, not a dead transducer, even though p1 had a fault announced already.
+TEST(SensorFaultReplay, AnOutageAfterASpikeIsNotADropout) {
+  const capture::Capture clean = capture(15, "healthy", 160.0, std::nullopt);
+  capture::Capture flaky = clean;
+  flaky.column("p1")[row_at(119.0)] += 3e6;
+  for (const char* name : {"p1", "p2", "x", "u"}) {
+    auto& v = flaky.column(name);
+    for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) v[i] = NAN;
+  }
+  const ReplayResult result = replay_capture(flaky, default_replay_config(flaky));
+  const auto faults = events_of(result, io::EventKind::alarm_raised, "sensor_fault");
+  ASSERT_EQ(faults.size(), 1u);
+  EXPECT_EQ(faults.front().channel, "p1");
+  EXPECT_EQ(faults.front().fault, "spikes");
+  EXPECT_TRUE(events_of(result, io::EventKind::alarm_raised, "internal_leakage").empty());
+}
+
 TEST(SensorFaultReplay, SpikesAreNamedAtOnceWithoutChangingTheLeakDecision) {
   const capture::Capture clean = capture(13, "healthy", 240.0, kLeakOnset - 60.0);
   capture::Capture spiky = clean;

@@ -3,14 +3,16 @@
 registers that follow a capture, with faults that can be switched on at run time.
 
   modbus_server.py --ready-file F (--tcp-port N | --serial DEVICE [--baud B --parity P])
-                   [--capture CSV --map SPEC --rate HZ] [--unit ID] [--slow-seconds S]
+                   [--capture CSV --map SPEC --rate HZ [--epoch T]] [--unit ID] [--slow-seconds S]
                    [--garbage]
 
 SPEC is a comma-separated list of name:register:address:type:order:scale:offset. `name` is a
-capture column, or `index...` (any name starting so) for the number of the sample being served (the test uses it to know
-which capture row a read saw). `register` is holding, input, coil or discrete_input; `address`
-is the protocol (0-based) address; type INT16 UINT16 INT32 UINT32 FLOAT32 FLOAT64; order ABCD
-CDAB BADC DCBA; the served raw value is (value - offset) / scale, rounded for integer types.
+capture column, or `index...` (any name starting so) for the number of the sample being served
+(the test uses it to know which capture row a read saw); the row served is the one due at the
+wall-clock time of the answer, counted from --epoch (default: the server's start). `register` is
+holding, input, coil or discrete_input; `address` is the protocol (0-based) address; type INT16
+UINT16 INT32 UINT32 FLOAT32 FLOAT64; order ABCD CDAB BADC DCBA; the served raw value is
+(value - offset) / scale, rounded for integer types.
 The encoding is written independently of leakmon's decoders (Python's struct), so the test is
 a check of one against the other.
 
@@ -78,6 +80,7 @@ class FaultySlaveContext(ModbusSlaveContext):
         self.refuse = False
         self.slow_seconds = slow_seconds
         self.requests = 0
+        self.before_answer = None
 
     def validate(self, fc_as_hex, address, count=1):
         self.requests += 1
@@ -85,6 +88,8 @@ class FaultySlaveContext(ModbusSlaveContext):
             time.sleep(self.slow_seconds)  # blocks the whole server, as a stalled device would
         if self.refuse:
             return False
+        if self.before_answer:
+            self.before_answer()
         return super().validate(fc_as_hex, address, count)
 
 
@@ -108,13 +113,15 @@ def parse_map(spec):
 
 
 class CaptureFollower:
-    """Serves row `index % rows` of the capture; the next row every 1/rate seconds."""
+    """Serves row `index % rows` of the capture, the next row every 1/rate seconds."""
 
     def __init__(self, slave, args):
         self.slave = slave
         self.columns, self.rows = read_capture(args.capture)
         self.entries = parse_map(args.map)
         self.period = 1.0 / args.rate
+        self.epoch = args.epoch if args.epoch is not None else time.time()
+        self.served = -1
 
     def serve(self, index):
         # No await in here: a request never sees half a row.
@@ -127,13 +134,15 @@ class CaptureFollower:
             else:
                 self.slave.setValues(function, address, encode(raw, data_type, order))
 
-    async def run(self):
-        start = time.monotonic()
-        index = 0
-        while True:
-            index += 1
-            await asyncio.sleep(max(0.0, start + index * self.period - time.monotonic()))
+    def serve_now(self):
+        # The row is picked when a request is answered, from the wall clock since `epoch`, as a
+        # device samples a process that goes on while its server is down or starved of CPU: a
+        # restarted server continues where the process is, and a late answer carries the newest
+        # row, never a stale one or a burst of them.
+        index = max(0, int((time.time() - self.epoch) / self.period))
+        if index != self.served:
             self.serve(index)
+            self.served = index
 
 
 async def serve_garbage(args):
@@ -165,8 +174,8 @@ async def main(args):
     loop.add_signal_handler(signal.SIGUSR2, lambda: setattr(slave, "refuse", not slave.refuse))
     if args.capture:
         follower = CaptureFollower(slave, args)
-        follower.serve(0)  # before the first request can arrive
-        asyncio.create_task(follower.run())
+        follower.serve_now()
+        slave.before_answer = follower.serve_now
     if args.serial:
         server = ModbusSerialServer(context, framer=ModbusRtuFramer, port=args.serial,
                                     baudrate=args.baud, parity=args.parity, bytesize=8,
@@ -195,6 +204,8 @@ if __name__ == "__main__":
     parser.add_argument("--capture")
     parser.add_argument("--map", default="")
     parser.add_argument("--rate", type=float, default=500.0)
+    parser.add_argument("--epoch", type=float,
+                        help="wall-clock time (s since 1970) of row 0; default: the server's start")
     parser.add_argument("--slow-seconds", type=float, default=0.2)
     parser.add_argument("--garbage", action="store_true")
     asyncio.run(main(parser.parse_args()))

@@ -30,6 +30,8 @@ std::vector<std::string> server_argv(const ModbusServerOptions& options) {
   if (!options.capture.empty())
     argv.insert(argv.end(), {"--capture", options.capture, "--map", options.map, "--rate",
                              std::to_string(options.rate_hz)});
+  if (!options.capture.empty() && options.epoch > 0.0)
+    argv.insert(argv.end(), {"--epoch", std::to_string(options.epoch)});
   argv.insert(argv.end(), {"--slow-seconds", std::to_string(options.slow_seconds)});
   if (options.garbage) argv.emplace_back("--garbage");
   return argv;

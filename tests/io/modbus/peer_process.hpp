@@ -36,6 +36,7 @@ struct ModbusServerOptions {
   std::string capture;       // capture CSV to follow
   std::string map;           // name:register:address:type:order:scale:offset,...
   double rate_hz = 500.0;
+  double epoch = 0.0;  // wall-clock time of the capture's row 0 (s since 1970); 0: server start
   double slow_seconds = 0.2;
   bool garbage = false;
 };
