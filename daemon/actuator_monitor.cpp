@@ -127,13 +127,18 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   double cleaned[3] = {kNaN, kNaN, kNaN};
   bool suspect = false;
   bool all_missing = !channels_.empty();
+  std::array<double, RepeatedSampleCheck::kMaxChannels> acquired{};
+  std::size_t acquired_channels = 0;
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     auto& channel = channels_[i];
     const double raw = value_at(sample, channel.index);
     all_missing = all_missing && std::isnan(raw);
     cleaned[i] = channel.check.push(raw);
     suspect |= channel.check.suspect();
+    acquired[acquired_channels++] = raw;
   }
+  if (layout_.u >= 0) acquired[acquired_channels++] = value_at(sample, layout_.u);
+  suspect |= check_repeats(sample.t, {acquired.data(), acquired_channels}, publish);
   check_sensor_faults(sample.t, all_missing, publish);
   if (std::isnan(protected_from_) && !std::isnan(sample.t)) {
     protected_from_ = sample.t + learning_seconds();
@@ -180,6 +185,31 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
   if (!features_.push(index_input_)) return false;
   decide(unchecked.t, publish);
   return true;
+}
+
+bool ActuatorMonitor::check_repeats(double t, std::span<const double> acquired,
+                                    const EventPublisher& publish) {
+  const bool repeating = repeats_.push(acquired);
+  if (repeating == announced_repeating_) return repeating;
+  announced_repeating_ = repeating;
+  // Not a transducer's fault: the acquisition's, reported like a driver's, with the actuator
+  // whose leak decision it holds.
+  io::Event event;
+  event.t = t;
+  event.actuator = config_.name;
+  event.kind = repeating ? io::EventKind::driver_fault : io::EventKind::driver_recovered;
+  event.message = repeating
+                      ? fmt::format(
+                            "{}: {} of the last {} samples repeat the one before exactly: the "
+                            "acquisition delivers new values slower than it samples (a device "
+                            "polled faster than it updates?); the leak decision is held",
+                            config_.name, repeats_.repeats(), RepeatedSampleCheck::kWindow)
+                      : fmt::format(
+                            "{}: samples are new again; the leak decision resumes after a "
+                            "window of them",
+                            config_.name);
+  publish(event);
+  return repeating;
 }
 
 void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPublisher& publish) {

@@ -14,11 +14,13 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
+#include "daemon/repeated_samples.hpp"
 #include "daemon/sample.hpp"
 #include "daemon/state_store.hpp"
 #include "detect/detector.hpp"
@@ -127,6 +129,8 @@ class ActuatorMonitor {
   io::Event alarm_event(io::EventKind kind, double t) const;
   // outage: every checked channel's raw value is missing in this sample.
   void check_sensor_faults(double t, bool outage, const EventPublisher& publish);
+  // Whether the acquisition repeats samples (RepeatedSampleCheck); announces changes.
+  bool check_repeats(double t, std::span<const double> acquired, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
 
   ActuatorConfig config_;
@@ -164,6 +168,8 @@ class ActuatorMonitor {
     bool in_outage = false;  // its dropout began with every channel missing (not announced)
   };
   std::vector<Channel> channels_;
+  RepeatedSampleCheck repeats_;
+  bool announced_repeating_ = false;
   double sample_rate_hz_;
   int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
