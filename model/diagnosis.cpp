@@ -129,7 +129,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   d.min_line_z = settings.min_line_z;
   d.ripple_line_significant = d.ripple_line && d.ripple_line->held_out_z >= settings.min_line_z;
   const auto library = effect_library(d.ripple_line_significant ? d.ripple_line->frequency_hz : 0.0,
-                                      !record.temp.empty());
+                                      !record.temp.empty(), record.dt);
 
   // m from the measured force balance, where it is usable: the simulation fit then calibrates
   // beta, Kv and b (from the force balance's b), and cannot slide along the beta/m/b valley.

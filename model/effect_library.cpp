@@ -97,7 +97,7 @@ double EffectCandidate::smallest() const {
   if (effect == "valve_bias") return 0.05 / 5.0;
   if (effect == "supply_droop") return 5e9 / 5.0;
   if (effect == "sensor_offset") return 5e4 / 5.0;
-  if (effect == "sensor_lag") return 0.002 / 5.0;
+  if (effect == "sensor_lag") return std::max(0.002 / 5.0, 0.5 * sample_period);
   return 0.0;  // spool lag: slower than the nominal spool; ripple: its line test
 }
 
@@ -123,7 +123,8 @@ bool EffectCandidate::plausible(const std::vector<double>& values) const {
   return signed_effect || main > 0.0;
 }
 
-std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature) {
+std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature,
+                                            double sample_period) {
   std::vector<EffectCandidate> out;
   out.push_back({"internal_leakage", "", {{"C_L", 1e-12, 1e-12, -2e-12, 5e-11}}, {}});
   for (const char* chamber : {"chamber 1", "chamber 2"}) {
@@ -155,6 +156,7 @@ std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperatu
   if (has_temperature) {
     out.push_back({"oil_temperature", "", {{"visc_slope", 0.01, 0.045, 0.0, 0.12}}, {}});
   }
+  for (auto& candidate : out) candidate.sample_period = sample_period;
   return out;
 }
 

@@ -27,7 +27,9 @@ struct EffectCandidate {
   // end of MODEL.md's range (0: no such floor). A fit far below it is the model absorbing
   // something else, not the effect (docs/model-check.md: a clean capture's Coulomb friction
   // of 0.4 N, against MODEL.md's 50-400 N, acted only through tanh(v / 1e-3) as extra damping
-  // at rest and soaked up the noise of each segment's starting velocity).
+  // at rest and soaked up the noise of each segment's starting velocity). A transducer lag
+  // must also reach half the capture's sample period: a shorter one is a sub-sample delay of
+  // the readings, not resolvable as a lag from the samples (see sample_period).
   double smallest() const;
   // Writes the discrete settings and parameter values into `e`.
   void apply(EffectParameters& e, const std::vector<double>& values) const;
@@ -36,6 +38,13 @@ struct EffectCandidate {
   // Set for a joint candidate (combine()): its parts, whose parameters `parameters` holds one
   // after the other; apply() and plausible() then act on each part's share of the values.
   std::vector<EffectCandidate> parts;
+  // The capture's sample period [s] (0: unknown). A first-order lag tau_s shorter than half of
+  // it passes 1 - exp(-dt / tau_s) > 86 % of a step within one sample: on the samples it is a
+  // delay of tau_s < dt / 2, the same as a sub-sample timing mismatch between the model and
+  // the capture (a friction reversal or a dead band's edge crossed between two samples), which
+  // it then stands in for (docs/model-check.md: a 0.72 ms lag at 500 Hz named as a third cause
+  // next to Coulomb friction and a valve bias).
+  double sample_period = 0.0;
   // `values` cut into the parts' shares (one share, all of them, for a single candidate).
   std::vector<std::vector<double>> split(const std::vector<double>& values) const;
 };
@@ -46,8 +55,10 @@ EffectCandidate combine(const std::vector<EffectCandidate>& parts);
 
 // Every candidate, in MODEL.md's order. `ripple_hz` seeds the supply_ripple frequency (0: the
 // capture shows no spectral line, and the ripple candidate is left out); oil_temperature
-// ("Drifting operating conditions") is a candidate only when the capture has `temp`.
-std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature = false);
+// ("Drifting operating conditions") is a candidate only when the capture has `temp`;
+// `sample_period` is the capture's (EffectCandidate::sample_period).
+std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature = false,
+                                            double sample_period = 0.0);
 
 // The eleven effect names of MODEL.md, in its order.
 const std::vector<std::string>& effect_names();
