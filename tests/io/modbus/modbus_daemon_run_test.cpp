@@ -175,5 +175,63 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotLeakAlarmsAndTheRecordingEqualsTheServedC
   }
 }
 
+// A device that updates its registers at 250 Hz, polled every 2 ms: every other sample the daemon
+// reads is the one before. That is the acquisition's fault: the daemon says so within a second
+// (driver_fault naming the actuator); that it then holds the leak decision, which such a stream
+// would otherwise turn into a false alarm, is tests/daemon/repeated_samples_test.cpp's.
+TEST(ModbusDaemonRun, ADeviceSlowerThanThePollIsReported) {
+  const std::string dir = scratch_dir("ModbusDaemonRunSlowDevice");
+  const std::string served = dir + "/healthy.csv";
+  ASSERT_EQ(std::system((leakmon_binary() + " sim --preset healthy --seed 12 --out " + served +
+                         " > " + dir + "/sim.log 2>&1")
+                            .c_str()),
+            0)
+      << read_text(dir + "/sim.log");
+  ModbusServerOptions options;
+  options.ready_file = dir + "/ready";
+  options.capture = served;
+  options.rate_hz = 250.0;
+  options.map = "p1:holding:0:FLOAT32:ABCD:1:0,p2:holding:2:FLOAT32:ABCD:1:0";
+  ModbusServer server(options);
+
+  const std::string config = dir + "/leakmon.yaml";
+  std::ofstream(config) << "drivers:\n"
+                           "  - name: daq\n"
+                           "    type: modbus\n"
+                           "    host: 127.0.0.1\n"
+                           "    port: "
+                        << server.port()
+                        << "\n"
+                           "    channels:\n"
+                           "      - {name: p1, address: 0, data_type: FLOAT32}\n"
+                           "      - {name: p2, address: 2, data_type: FLOAT32}\n"
+                           "sampling:\n"
+                           "  - {name: main, period_ms: 2, drivers: [daq], priority: 0}\n"
+                           "actuators:\n"
+                           "  - name: cylinder\n"
+                           "    channels: {p1: daq.p1, p2: daq.p2}\n"
+                           "    detector:\n"
+                           "      kind: default\n"
+                           "      options: {settle_seconds: 2, learn_seconds: 8}\n"
+                           "events:\n"
+                           "  log: events.jsonl\n"
+                           "state:\n"
+                           "  directory: state\n"
+                           "metrics:\n"
+                           "  port: 0\n";
+  ChildProcess daemon({leakmon_binary(), "run", "--config", config}, dir + "/daemon.log");
+  sleep_s(8.0);
+  EXPECT_EQ(daemon.stop_and_wait(SIGTERM, 20.0), 0) << read_text(dir + "/daemon.log");
+
+  const std::string events = read_text(dir + "/events.jsonl");
+  const auto fault = events.find("\"event\": \"driver_fault\", \"actuator\": \"cylinder\"");
+  ASSERT_NE(fault, std::string::npos) << events;
+  const auto line_start = events.rfind('\n', fault);
+  const std::string line = events.substr(line_start == std::string::npos ? 0 : line_start + 1,
+                                         events.find('\n', fault) - line_start);
+  EXPECT_NE(line.find("repeat the one before"), std::string::npos) << line;
+  EXPECT_LT(number_after(line, "\"t\": "), 2.0) << line;
+}
+
 }  // namespace
 }  // namespace leakmon::test
