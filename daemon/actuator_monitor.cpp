@@ -392,6 +392,7 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.decisions = decisions_;
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;
+  status.repeated_samples = repeats_.repeats();
   status.suspended_decisions = suspended_decisions_;
   status.relearns = relearns_;
   // The detector counts its own hops (it does not learn while a faulty channel suspends it);

@@ -67,6 +67,8 @@ struct ActuatorStatus {
   double p2 = io::kNoValue;
   std::uint64_t decisions = 0;
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
+  // Samples among the last RepeatedSampleCheck::kWindow that repeat the one before exactly.
+  std::uint64_t repeated_samples = 0;
   std::vector<ChannelHealth> channels;
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason

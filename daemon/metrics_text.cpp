@@ -195,6 +195,14 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   for (const auto& a : actuators) {
     out.sample("leakmon_detector_suspended", label("actuator", a.name), flag(a.suspended));
   }
+  out.family("leakmon_acquisition_repeated_samples",
+             "samples of the last second that repeat the one before exactly (100 of 500: the "
+             "acquisition is slower than its sampling, and the leak decision is held)",
+             "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_acquisition_repeated_samples", label("actuator", a.name),
+               static_cast<double>(a.repeated_samples));
+  }
   out.family("leakmon_learned_state_age_seconds",
              "seconds since the learned state kept in the state directory was saved", "gauge");
   for (const auto& a : actuators) {

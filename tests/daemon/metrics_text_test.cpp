@@ -238,6 +238,7 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.alarm = "internal_leakage";
   fresh.detector = "default";
   fresh.channels = {{"p1", io::DeviceStatus::function_check, detect::SensorFault::none, 0}};
+  fresh.repeated_samples = 250;  // a device updating at half the sampling rate
   const std::vector<ActuatorStatus> actuators = {leaking_actuator(), fresh};
   PrometheusText out;
   actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
@@ -267,6 +268,9 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   EXPECT_EQ(
       value_of(text, "leakmon_sensor_spikes_rejected_total{actuator=\"lift\",channel=\"p2\"}"),
       "3");
+
+  EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"clamp\"}"), "250");
+  EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"lift\"}"), "0");
 
   EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "42.5");
   // No saved state: no age sample (not a zero that would read as "just saved"); an actuator
