@@ -132,12 +132,12 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   for (const auto& a : actuators) {
     out.sample("leakmon_detector_learning", label("actuator", a.name), flag(a.learning));
   }
-  out.family("leakmon_learning_seconds_lefteconds",
+  out.family("leakmon_learning_remaining_seconds",
              "source time until the detector decides (0: it decides; after a reload that "
              "invalidated what it learned, until it has learned again)",
              "gauge");
   for (const auto& a : actuators) {
-    out.sample("leakmon_learning_seconds_lefteconds", label("actuator", a.name),
+    out.sample("leakmon_learning_remaining_seconds", label("actuator", a.name),
                a.learning_seconds_left);
   }
   out.family("leakmon_relearn_total",

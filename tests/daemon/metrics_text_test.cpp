@@ -239,6 +239,7 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.detector = "default";
   fresh.channels = {{"p1", io::DeviceStatus::function_check, detect::SensorFault::none, 0}};
   fresh.repeated_samples = 250;  // a device updating at half the sampling rate
+  fresh.learning_seconds_left = 37.5;
   const std::vector<ActuatorStatus> actuators = {leaking_actuator(), fresh};
   PrometheusText out;
   actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
@@ -269,6 +270,8 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
       value_of(text, "leakmon_sensor_spikes_rejected_total{actuator=\"lift\",channel=\"p2\"}"),
       "3");
 
+  // The name docs/daemon.md and config/README.md give.
+  EXPECT_EQ(value_of(text, "leakmon_learning_remaining_seconds{actuator=\"clamp\"}"), "37.5");
   EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"clamp\"}"), "250");
   EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"lift\"}"), "0");
 
