@@ -189,9 +189,9 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
 
 bool ActuatorMonitor::check_repeats(double t, std::span<const double> acquired,
                                     const EventPublisher& publish) {
+  const bool was_repeating = repeats_.repeating();
   const bool repeating = repeats_.push(acquired);
-  if (repeating == announced_repeating_) return repeating;
-  announced_repeating_ = repeating;
+  if (repeating == was_repeating) return repeating;
   // Not a transducer's fault: the acquisition's, reported like a driver's, with the actuator
   // whose leak decision it holds.
   io::Event event;

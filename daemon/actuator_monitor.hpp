@@ -171,7 +171,6 @@ class ActuatorMonitor {
   };
   std::vector<Channel> channels_;
   RepeatedSampleCheck repeats_;
-  bool announced_repeating_ = false;
   double sample_rate_hz_;
   int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.

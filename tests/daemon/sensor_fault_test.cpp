@@ -46,6 +46,16 @@ void freeze(capture::Capture& c, const std::string& channel, double from, double
     v[i] = v[row_at(from) - 1];
 }
 
+void drop(capture::Capture& c, const std::string& channel, double from, double to) {
+  auto& v = c.column(channel);
+  for (std::size_t i = row_at(from); i < row_at(to) && i < v.size(); ++i) v[i] = NAN;
+}
+
+// The acquisition loses every channel at once (a driver reconnecting).
+void outage(capture::Capture& c, double from, double to) {
+  for (const char* name : {"p1", "p2", "x", "u"}) drop(c, name, from, to);
+}
+
 std::vector<io::Event> events_of(const ReplayResult& r, io::EventKind kind,
                                  const std::string& alarm) {
   std::vector<io::Event> out;
@@ -121,18 +131,14 @@ TEST(SensorFaultReplay, WithoutTheCheckAFrozenP1LooksLikeALeak) {
 // driver_fault by the daemon, not a transducer; one channel missing alone is a dropout.
 TEST(SensorFaultReplay, AnOutageOfEveryChannelIsNotASensorFaultButOneMissingChannelIs) {
   const capture::Capture clean = capture(14, "healthy", 160.0, std::nullopt);
-  capture::Capture outage = clean;
-  for (const char* name : {"p1", "p2", "x", "u"}) {
-    auto& v = outage.column(name);
-    for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) v[i] = NAN;
-  }
-  const ReplayResult all = replay_capture(outage, default_replay_config(outage));
+  capture::Capture lost = clean;
+  outage(lost, 120.0, 122.0);
+  const ReplayResult all = replay_capture(lost, default_replay_config(lost));
   EXPECT_TRUE(events_of(all, io::EventKind::alarm_raised, "sensor_fault").empty());
   EXPECT_TRUE(events_of(all, io::EventKind::alarm_raised, "internal_leakage").empty());
 
   capture::Capture one = clean;
-  auto& p2 = one.column("p2");
-  for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) p2[i] = NAN;
+  drop(one, "p2", 120.0, 122.0);
   const ReplayResult single = replay_capture(one, default_replay_config(one));
   const auto faults = events_of(single, io::EventKind::alarm_raised, "sensor_fault");
   ASSERT_EQ(faults.size(), 1u);
@@ -148,10 +154,7 @@ TEST(SensorFaultReplay, AnOutageAfterASpikeIsNotADropout) {
   const capture::Capture clean = capture(15, "healthy", 160.0, std::nullopt);
   capture::Capture flaky = clean;
   flaky.column("p1")[row_at(119.0)] += 3e6;
-  for (const char* name : {"p1", "p2", "x", "u"}) {
-    auto& v = flaky.column(name);
-    for (std::size_t i = row_at(120.0); i < row_at(122.0); ++i) v[i] = NAN;
-  }
+  outage(flaky, 120.0, 122.0);
   const ReplayResult result = replay_capture(flaky, default_replay_config(flaky));
   const auto faults = events_of(result, io::EventKind::alarm_raised, "sensor_fault");
   ASSERT_EQ(faults.size(), 1u);

@@ -54,14 +54,21 @@ double damaged_row_fraction(const capture::Capture& recorded, double from, doubl
   return rows == 0 ? 0.0 : static_cast<double>(damaged) / static_cast<double>(rows);
 }
 
+// A healthy simulated capture for the server to follow, written into `dir`.
+std::string simulate_served_capture(const std::string& dir, int seed) {
+  const std::string served = dir + "/healthy.csv";
+  const int status =
+      std::system((leakmon_binary() + " sim --preset healthy --seed " + std::to_string(seed) +
+                   " --out " + served + " > " + dir + "/sim.log 2>&1")
+                      .c_str());
+  EXPECT_EQ(status, 0) << read_text(dir + "/sim.log");
+  return served;
+}
+
 TEST(ModbusDaemonRun, FaultsGiveGapsNotLeakAlarmsAndTheRecordingEqualsTheServedCapture) {
   const std::string dir = scratch_dir("ModbusDaemonRun");
-  const std::string served = dir + "/healthy.csv";
-  ASSERT_EQ(std::system((leakmon_binary() + " sim --preset healthy --seed 11 --out " + served +
-                         " > " + dir + "/sim.log 2>&1")
-                            .c_str()),
-            0)
-      << read_text(dir + "/sim.log");
+  const std::string served = simulate_served_capture(dir, 11);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const capture::Capture capture = capture::read_capture(served);
 
   ModbusServerOptions options;
@@ -181,12 +188,8 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotLeakAlarmsAndTheRecordingEqualsTheServedC
 // would otherwise turn into a false alarm, is tests/daemon/repeated_samples_test.cpp's.
 TEST(ModbusDaemonRun, ADeviceSlowerThanThePollIsReported) {
   const std::string dir = scratch_dir("ModbusDaemonRunSlowDevice");
-  const std::string served = dir + "/healthy.csv";
-  ASSERT_EQ(std::system((leakmon_binary() + " sim --preset healthy --seed 12 --out " + served +
-                         " > " + dir + "/sim.log 2>&1")
-                            .c_str()),
-            0)
-      << read_text(dir + "/sim.log");
+  const std::string served = simulate_served_capture(dir, 12);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   ModbusServerOptions options;
   options.ready_file = dir + "/ready";
   options.capture = served;
