@@ -70,27 +70,32 @@ TEST(SeveralEffects, SubSampleLagIsNeverNamedASensorLag) {
   // fitted close to its value (0.75-0.86 ms for 0.7-0.8 ms in the runs seen), so the fit lands
   // below 1 ms and the diagnosis must find it not plausible; under the fifth-of-the-range rule
   // alone (0.4 ms) it was plausible and, with t >= 2.5 (about one capture in four), named.
+  // Fresh draws: the fit scatters (1.26 ms once), so up to four captures are drawn until one
+  // exercises the rule; none of them may name the lag.
   const auto seed = test::model_test_seed("sub-sample lag");
-  SyntheticCase c = draw_case(seed, "sensor_lag");
-  ASSERT_TRUE(c.scenario.effects.sensor_lag.has_value());
-  c.scenario.effects.sensor_lag->tau_s = 0.0007;
-  const MeasuredRecord record = measured_record(simulate_case(c));
-  const Diagnosis d = diagnose(record);
-  std::printf("sub-sample lag: cause %s, causes %s, nrmse %.4f -> %.4f, floor %.4f\n",
-              d.cause.c_str(), causes(d).c_str(), d.nrmse_before, d.nrmse_after, d.nrmse_floor);
-  EXPECT_FALSE(named(d, "sensor_lag"));
   bool fitted_below_half_a_sample = false;
-  for (const auto& r : d.ranking) {
-    if (r.effect != "sensor_lag" || r.params.empty()) continue;
-    const double tau_s = r.params.front().value;
-    std::printf("sensor_lag fitted tau_s %.5f s, score %.4f, t %.2f, plausible %d\n", tau_s,
-                r.score, r.significance, r.plausible ? 1 : 0);
-    fitted_below_half_a_sample = tau_s < 0.5 * record.dt;
-    if (fitted_below_half_a_sample) {
-      EXPECT_FALSE(r.plausible);
+  for (unsigned draw = 0; draw < 4 && !fitted_below_half_a_sample; ++draw) {
+    SyntheticCase c = draw_case(seed + draw, "sensor_lag");
+    ASSERT_TRUE(c.scenario.effects.sensor_lag.has_value());
+    c.scenario.effects.sensor_lag->tau_s = 0.0007;
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const Diagnosis d = diagnose(record);
+    std::printf("sub-sample lag, draw %u: cause %s, causes %s, nrmse %.4f -> %.4f, floor %.4f\n",
+                draw, d.cause.c_str(), causes(d).c_str(), d.nrmse_before, d.nrmse_after,
+                d.nrmse_floor);
+    EXPECT_FALSE(named(d, "sensor_lag")) << "draw " << draw;
+    for (const auto& r : d.ranking) {
+      if (r.effect != "sensor_lag" || r.params.empty()) continue;
+      const double tau_s = r.params.front().value;
+      std::printf("sensor_lag fitted tau_s %.5f s, score %.4f, t %.2f, plausible %d\n", tau_s,
+                  r.score, r.significance, r.plausible ? 1 : 0);
+      if (tau_s < 0.5 * record.dt) {
+        fitted_below_half_a_sample = true;
+        EXPECT_FALSE(r.plausible) << "draw " << draw;
+      }
     }
   }
-  // Otherwise the run did not exercise the rule.
+  // Otherwise no draw exercised the rule.
   EXPECT_TRUE(fitted_below_half_a_sample);
 }
 
