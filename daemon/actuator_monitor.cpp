@@ -34,6 +34,15 @@ std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
   return detect::make_detector(config.detector, signals, hop_seconds, options);
 }
 
+// Learning hops the mode verdict needs at least (1 s at the default hop of 40 ms); with fewer the
+// rig stays unjudged.
+constexpr std::size_t kModeJudgedHops = 25;
+
+ModeVisibilityCheck mode_check(const detect::TransducerSpec& spec) {
+  return ModeVisibilityCheck(
+      ModeVisibilityCheck::noise_floor_pa(spec.noise_sigma, spec.resolution));
+}
+
 }  // namespace
 
 ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayout& layout,
@@ -49,6 +58,8 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       activity_(config.features.window, kNaN),
       index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
       sample_rate_hz_(1e9 / static_cast<double>(period_ns)),
+      watch_mode_(detector_->needs_hydraulic_mode()),
+      mode_checks_{mode_check(config.p1_transducer), mode_check(config.p2_transducer)},
       period_ns_(period_ns) {
   const double rate = sample_rate_hz_;
   channels_.reserve(3);
@@ -135,7 +146,10 @@ bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) 
     all_missing = all_missing && std::isnan(raw);
     cleaned[i] = channel.check.push(raw);
     suspect |= channel.check.suspect();
-    acquired[acquired_channels++] = raw;
+    // A channel its own check calls faulty (frozen, saturated: constant by its fault) is
+    // reported there; a sample with it is no evidence of a repeating acquisition (NaN is never
+    // a repeat), and the leak decision is held for the fault anyway.
+    acquired[acquired_channels++] = channel.check.fault() == detect::SensorFault::none ? raw : kNaN;
   }
   if (layout_.u >= 0) acquired[acquired_channels++] = value_at(sample, layout_.u);
   suspect |= check_repeats(sample.t, {acquired.data(), acquired_channels}, publish);
@@ -210,6 +224,42 @@ bool ActuatorMonitor::check_repeats(double t, std::span<const double> acquired,
                             config_.name);
   publish(event);
   return repeating;
+}
+
+void ActuatorMonitor::judge_mode_visibility(double t, const detect::Observation& observation,
+                                            const EventPublisher& publish) {
+  if (!mode_judged_) {
+    if (last_decision_.learning) {
+      mode_checks_[0].add(observation.index_p1);
+      mode_checks_[1].add(observation.index_p2);
+      return;
+    }
+    mode_judged_ = true;
+    for (const auto& check : mode_checks_) {
+      if (check.count() < kModeJudgedHops) continue;
+      const double ratio = check.median_ratio();
+      if (!(healthy_index_ratio_ >= ratio)) healthy_index_ratio_ = ratio;
+    }
+    announce_blind_ = detection_blind();
+  }
+  if (!announce_blind_) return;
+  announce_blind_ = false;
+  io::Event event;
+  event.kind = io::EventKind::detection_blind;
+  event.t = t;
+  event.actuator = config_.name;
+  event.channel = "p1";
+  const double floor = mode_checks_[0].noise_floor();
+  event.baseline = healthy_index_ratio_ * floor;
+  event.message = fmt::format(
+      "{}: the hydraulic mode hardly shows in the chamber pressures (median index while "
+      "learning {:.1f} kPa, {:.1f} x the transducer's noise of {:.1f} kPa; below {:.1f} x no "
+      "leak was found): the {} detector sees a leak only through that mode, so {} cannot be "
+      "raised on this rig. Seal friction holding the piston at rest, or much free air, does "
+      "this; acquire the valve command u and the position x for the flow balance",
+      config_.name, event.baseline / 1e3, healthy_index_ratio_, floor / 1e3,
+      ModeVisibilityCheck::kBlindRatio, detector_->name(), config_.alarm_name);
+  publish(event);
 }
 
 void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPublisher& publish) {
@@ -296,6 +346,7 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   last_decision_ = detector_->update(observation);
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
+  if (watch_mode_) judge_mode_visibility(t, observation, publish);
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
   if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));
@@ -346,6 +397,7 @@ ActuatorState ActuatorMonitor::export_state() const {
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   state.alarm = alarm_.state();
   state.alarm_condition = alarm_.condition();
+  if (mode_judged_) state.healthy_index_ratio = healthy_index_ratio_;
   state.detector = detector_->export_state();
   return state;
 }
@@ -358,6 +410,11 @@ void ActuatorMonitor::import_state(const ActuatorState& state) {
     throw;
   }
   alarm_.restore(state.alarm, state.alarm_condition);
+  // The verdict of the learning period the state comes from; a state without one (older, or
+  // saved before learning ended) stays unjudged: later hops may carry a leak.
+  mode_judged_ = true;
+  healthy_index_ratio_ = state.healthy_index_ratio;
+  announce_blind_ = detection_blind();
   detector_->resume_after_gap();
   detect::Observation gap;
   last_decision_ = detector_->update(gap);
@@ -393,6 +450,8 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.gap_samples = gap_samples_;
   status.suspended = fed_ < blocked_until_;
   status.repeated_samples = repeats_.repeats();
+  status.mode_visibility = watch_mode_ ? healthy_index_ratio_ : io::kNoValue;
+  status.detection_blind = detection_blind();
   status.suspended_decisions = suspended_decisions_;
   status.relearns = relearns_;
   // The detector counts its own hops (it does not learn while a faulty channel suspends it);

@@ -20,6 +20,7 @@
 
 #include "daemon/alarm.hpp"
 #include "daemon/config.hpp"
+#include "daemon/mode_visibility.hpp"
 #include "daemon/repeated_samples.hpp"
 #include "daemon/sample.hpp"
 #include "daemon/state_store.hpp"
@@ -69,6 +70,11 @@ struct ActuatorStatus {
   std::uint64_t gap_samples = 0;  // samples that arrived as gaps (missed ticks, NaN reads)
   // Samples among the last RepeatedSampleCheck::kWindow that repeat the one before exactly.
   std::uint64_t repeated_samples = 0;
+  // Pressure-only detectors: the median index of the learning period over the transducer's noise
+  // floor, best chamber (NaN before learning ends, or when the detector does not need the
+  // hydraulic mode), and whether that makes the rig blind to a leak (ModeVisibilityCheck).
+  double mode_visibility = io::kNoValue;
+  bool detection_blind = false;
   std::vector<ChannelHealth> channels;
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
@@ -134,6 +140,13 @@ class ActuatorMonitor {
   // Whether the acquisition repeats samples (RepeatedSampleCheck); announces changes.
   bool check_repeats(double t, std::span<const double> acquired, const EventPublisher& publish);
   AlarmSettings effective(const AlarmSettings& configured) const;
+  // Feeds the mode checks with a learning hop's indices; when learning ends, judges them and
+  // announces a blind rig (and once more after a restart restored that verdict).
+  void judge_mode_visibility(double t, const detect::Observation& observation,
+                             const EventPublisher& publish);
+  bool detection_blind() const {
+    return watch_mode_ && healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio;
+  }
 
   ActuatorConfig config_;
   ChannelLayout layout_;
@@ -172,6 +185,12 @@ class ActuatorMonitor {
   std::vector<Channel> channels_;
   RepeatedSampleCheck repeats_;
   double sample_rate_hz_;
+  // Only for a detector that needs the hydraulic mode (watch_mode_): p1's and p2's checks.
+  bool watch_mode_;
+  std::array<ModeVisibilityCheck, 2> mode_checks_;
+  bool mode_judged_ = false;
+  double healthy_index_ratio_ = io::kNoValue;
+  bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision
   int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {

@@ -73,6 +73,7 @@ void LogEventSink::publish(const io::Event& event) {
   const auto level =
       (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
        event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected ||
+       event.kind == io::EventKind::detection_blind ||
        event.kind == io::EventKind::state_discarded ||
        event.kind == io::EventKind::state_save_failed)
           ? spdlog::level::warn

@@ -203,6 +203,22 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
     out.sample("leakmon_acquisition_repeated_samples", label("actuator", a.name),
                static_cast<double>(a.repeated_samples));
   }
+  out.family("leakmon_hydraulic_mode_visibility",
+             "pressure-only detectors: median index while learning over the transducer's noise "
+             "floor, best chamber (below 2.5 the rig is blind to a leak: detection_blind)",
+             "gauge");
+  for (const auto& a : actuators) {
+    if (std::isfinite(a.mode_visibility)) {
+      out.sample("leakmon_hydraulic_mode_visibility", label("actuator", a.name), a.mode_visibility);
+    }
+  }
+  out.family("leakmon_detection_blind",
+             "1 when a pressure-only detector's rig showed no hydraulic mode to see a leak by "
+             "while it learned",
+             "gauge");
+  for (const auto& a : actuators) {
+    out.sample("leakmon_detection_blind", label("actuator", a.name), flag(a.detection_blind));
+  }
   out.family("leakmon_learned_state_age_seconds",
              "seconds since the learned state kept in the state directory was saved", "gauge");
   for (const auto& a : actuators) {

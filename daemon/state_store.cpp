@@ -131,6 +131,9 @@ std::string encode_state(const ActuatorState& state) {
   out += "saved_unix " + detect::format_double(state.saved_unix) + "\n";
   out += fmt::format("alarm {}\n", to_string(state.alarm));
   out += fmt::format("alarm_condition {}\n", state.alarm_condition ? 1 : 0);
+  if (std::isfinite(state.healthy_index_ratio)) {
+    out += "healthy_index_ratio " + detect::format_double(state.healthy_index_ratio) + "\n";
+  }
   out += "detector\n";
   out += state.detector.text();
   out += "checksum " + fnv1a64(out) + "\n";
@@ -200,7 +203,12 @@ ActuatorState decode_state(const std::string& text) {
   const std::string condition = rest_after(next(), "alarm_condition");
   if (condition != "0" && condition != "1") throw StateError("alarm_condition not 0 or 1");
   state.alarm_condition = condition == "1";
-  if (next() != "detector") throw StateError("expected 'detector'");
+  line = next();
+  if (line.rfind("healthy_index_ratio ", 0) == 0) {
+    state.healthy_index_ratio = detect::parse_double(rest_after(line, "healthy_index_ratio"));
+    line = next();
+  }
+  if (line != "detector") throw StateError("expected 'detector'");
   std::string detector;
   for (; i + 1 < lines.size(); ++i) {
     detector += lines[i];

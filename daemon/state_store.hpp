@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -21,7 +22,9 @@
 
 namespace leakmon::daemon {
 
-inline constexpr int kStateFormatVersion = 1;
+// 2: the learning period's index over the noise floor (healthy_index_ratio), optional; version 1
+// files (without it) still load.
+inline constexpr int kStateFormatVersion = 2;
 
 // The configuration one actuator's state depends on, as named parts (for messages that say
 // what changed) and their hash. Driver names are left out: a state learned by replaying a
@@ -45,6 +48,9 @@ struct ActuatorState {
   double saved_unix = 0.0;  // wall-clock time of saving [s since 1970]
   AlarmState alarm = AlarmState::normal;
   bool alarm_condition = false;
+  // What the learning period's index said about the hydraulic mode (daemon/mode_visibility.hpp):
+  // its median over the noise floor, NaN when not judged.
+  double healthy_index_ratio = std::numeric_limits<double>::quiet_NaN();
   detect::DetectorState detector;
 };
 

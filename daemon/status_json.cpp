@@ -73,15 +73,16 @@ std::string Daemon::status_json() const {
         "\"t\":{},\"index_pa\":{{\"p1\":{},\"p2\":{}}},\"score\":{},\"threshold\":{{\"raise\":{},"
         "\"clear\":{}}},\"baseline_pa\":{},\"leak_lpm_per_mpa\":{{\"estimate\":{},\"ci95\":{}}},"
         "\"oil_temperature_c\":{},\"alarms\":[{{\"name\":{},\"state\":{}}}],\"suspended\":{},"
-        "\"decisions\":{},\"gap_samples\":{},\"sensors\":[",
+        "\"mode_visibility\":{},\"detection_blind\":{},\"decisions\":{},\"gap_samples\":{},"
+        "\"sensors\":[",
         i == 0 ? "" : ",", json_string(a.name), json_string(a.detector), state,
         json_number(a.learning ? a.learning_seconds_left : NAN), json_number(a.t),
         json_number(a.index_p1), json_number(a.index_p2), json_number(a.score),
         json_number(a.raise_threshold), json_number(a.clear_threshold), json_number(a.baseline),
         json_number(units::lpm_per_mpa(a.leak_coefficient)),
         json_number(units::lpm_per_mpa(a.leak_coefficient_ci)), json_number(a.oil_temperature),
-        json_string(a.alarm), json_string(to_string(a.state)), flag(a.suspended), a.decisions,
-        a.gap_samples);
+        json_string(a.alarm), json_string(to_string(a.state)), flag(a.suspended),
+        json_number(a.mode_visibility), flag(a.detection_blind), a.decisions, a.gap_samples);
     for (std::size_t k = 0; k < a.channels.size(); ++k) {
       const auto& c = a.channels[k];
       out += fmt::format(
@@ -196,6 +197,12 @@ std::string status_text_from_json(std::string_view json) {
                            text(c["spikes_rejected"]));
       }
       if (a["suspended"].as<bool>()) out += "  leak decision suspended (sensor fault)\n";
+      if (a["detection_blind"] && a["detection_blind"].as<bool>()) {
+        out += fmt::format(
+            "  BLIND: the hydraulic mode hardly showed while learning (median index {:.1f} x "
+            "the transducer noise); no leak alarm can come from this detector\n",
+            number(a["mode_visibility"]));
+      }
     }
     return out;
   } catch (const YAML::Exception& e) {

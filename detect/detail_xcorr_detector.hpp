@@ -48,6 +48,7 @@ class DetailXcorrDetector final : public Detector {
   DetailXcorrDetector(const DetailXcorrOptions& options, double hop_seconds);
 
   std::string_view name() const override { return "detail_xcorr"; }
+  bool needs_hydraulic_mode() const override { return true; }
   Decision update(const Observation& observation) override;
   double raise_threshold() const override { return test_.raise_threshold(); }
   double clear_threshold() const override { return test_.clear_threshold(); }

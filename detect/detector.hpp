@@ -86,6 +86,11 @@ class Detector {
   // Source time [s] from a fresh start (or reset()) to its first decision: what it ignores as
   // start-up transient plus what it learns from. NaN when the detector cannot say.
   virtual double learning_seconds() const { return std::numeric_limits<double>::quiet_NaN(); }
+  // Whether it sees a leak only through the hydraulic mode in the chamber pressures (the ~75 Hz
+  // resonance the level-2 details cover): then a rig whose mode does not show above the
+  // transducers' noise gives it nothing to see, and the daemon says so
+  // (daemon/mode_visibility.hpp).
+  virtual bool needs_hydraulic_mode() const { return false; }
 };
 
 }  // namespace leakmon::detect

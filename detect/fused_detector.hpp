@@ -34,6 +34,12 @@ class FusedDetector final : public Detector {
     return longest;
   }
 
+  // Blind without the mode only when every member is.
+  bool needs_hydraulic_mode() const override {
+    return std::all_of(members_.begin(), members_.end(),
+                       [](const auto& member) { return member->needs_hydraulic_mode(); });
+  }
+
   // The latest decision of each member (same order as given), for diagnostics and evaluation.
   const std::vector<Decision>& member_decisions() const { return member_decisions_; }
   const std::vector<std::unique_ptr<Detector>>& members() const { return members_; }

@@ -75,6 +75,7 @@ class IndexCusumDetector final : public Detector {
   IndexCusumDetector(const IndexCusumOptions& options, double hop_seconds);
 
   std::string_view name() const override { return "index_cusum"; }
+  bool needs_hydraulic_mode() const override { return true; }
   Decision update(const Observation& observation) override;
   double raise_threshold() const override { return 1.0; }
   double clear_threshold() const override { return 0.5; }

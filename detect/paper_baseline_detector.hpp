@@ -27,6 +27,7 @@ class PaperBaselineDetector final : public Detector {
   PaperBaselineDetector(const PaperBaselineOptions& options, double hop_seconds);
 
   std::string_view name() const override { return "paper"; }
+  bool needs_hydraulic_mode() const override { return true; }
   Decision update(const Observation& observation) override;
   double raise_threshold() const override { return options_.raise_fraction; }
   double clear_threshold() const override { return options_.clear_fraction; }

@@ -36,6 +36,10 @@ enum class EventKind {
   // A reload changed an option what the detector learned depends on: it learns again, and
   // detects nothing until `protected_from`.
   relearning,
+  // A pressure-only detector's rig: the hydraulic mode it sees a leak through hardly shows above
+  // the transducers' noise while it learns (daemon/mode_visibility.hpp), so no leak alarm can
+  // come from it. Announced when learning ends and again after a restart.
+  detection_blind,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -68,6 +72,8 @@ constexpr std::string_view to_string(EventKind kind) {
       return "daemon_stopped";
     case EventKind::relearning:
       return "relearning";
+    case EventKind::detection_blind:
+      return "detection_blind";
   }
   return "unknown";
 }

@@ -240,6 +240,8 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.channels = {{"p1", io::DeviceStatus::function_check, detect::SensorFault::none, 0}};
   fresh.repeated_samples = 250;  // a device updating at half the sampling rate
   fresh.learning_seconds_left = 37.5;
+  fresh.mode_visibility = 1.6;  // learned on a rig whose hydraulic mode did not show
+  fresh.detection_blind = true;
   const std::vector<ActuatorStatus> actuators = {leaking_actuator(), fresh};
   PrometheusText out;
   actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
@@ -274,6 +276,12 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   EXPECT_EQ(value_of(text, "leakmon_learning_remaining_seconds{actuator=\"clamp\"}"), "37.5");
   EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"clamp\"}"), "250");
   EXPECT_EQ(value_of(text, "leakmon_acquisition_repeated_samples{actuator=\"lift\"}"), "0");
+
+  EXPECT_EQ(value_of(text, "leakmon_hydraulic_mode_visibility{actuator=\"clamp\"}"), "1.6");
+  // Not judged (flow balance, or still learning): no sample rather than a number.
+  EXPECT_EQ(lines_starting(text, "leakmon_hydraulic_mode_visibility{"), 1u);
+  EXPECT_EQ(value_of(text, "leakmon_detection_blind{actuator=\"clamp\"}"), "1");
+  EXPECT_EQ(value_of(text, "leakmon_detection_blind{actuator=\"lift\"}"), "0");
 
   EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "42.5");
   // No saved state: no age sample (not a zero that would read as "just saved"); an actuator

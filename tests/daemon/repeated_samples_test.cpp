@@ -107,5 +107,34 @@ TEST(RepeatedSamplesReplay, AHeldStreamHoldsTheDecisionInsteadOfRaisingALeak) {
   }));
 }
 
+// A frozen transducer is a sensor fault, not a repeating acquisition. On a rig that seal
+// friction holds at rest, p2 is quiet enough to repeat its reading one sample in three or more:
+// while p1 was frozen, every such sample repeated on both channels, and a frozen p1 was also
+// reported as driver_fault. The sample with a faulty channel no longer counts as a repeat.
+TEST(RepeatedSamplesReplay, AFrozenChannelIsASensorFaultNotARepeatingAcquisition) {
+  sim::Scenario scenario = sim::preset("healthy", 61);
+  scenario.duration_s = 200.0;
+  const sim::EffectParameter friction[] = {{"F_C", 120.0}};
+  scenario.effects.enable("coulomb_friction", friction);
+  const capture::Capture full = sim::simulate(scenario);
+  capture::Capture pressures;
+  pressures.metadata = full.metadata;
+  for (const char* name : {"t", "p1", "p2"}) {
+    pressures.columns.push_back(name);
+    pressures.values.push_back(full.column(name));
+  }
+  auto& p1 = pressures.column("p1");
+  for (std::size_t i = 150 * 500; i < 158 * 500; ++i) p1[i] = p1[150 * 500 - 1];
+
+  const ReplayResult result = replay_capture(pressures, default_replay_config(pressures));
+  bool frozen = false;
+  for (const auto& e : result.events) {
+    EXPECT_NE(e.kind, io::EventKind::driver_fault) << "t " << e.t << ": " << e.message;
+    frozen |= e.kind == io::EventKind::alarm_raised && e.alarm == "sensor_fault" &&
+              e.channel == "p1" && e.fault == "frozen";
+  }
+  EXPECT_TRUE(frozen);
+}
+
 }  // namespace
 }  // namespace leakmon::daemon

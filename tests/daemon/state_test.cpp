@@ -126,7 +126,7 @@ TEST(StateStore, DamagedNewerOrChangedFilesAreSetAsideWithAWarning) {
                            saved.fingerprint)
                    .empty());
   std::string newer = good;
-  newer.replace(0, newer.find('\n'), "leakmon-state 2");
+  newer.replace(0, newer.find('\n'), "leakmon-state " + std::to_string(kStateFormatVersion + 1));
   EXPECT_NE(warning_for(newer, saved.fingerprint).find("newer"), std::string::npos);
   ActuatorConfig changed = actuator("ram");
   changed.features.window = 512;
