@@ -25,7 +25,9 @@ From the per-block bound (level unknown), an ideal CUSUM of the exact log-likeli
 gives the share of leaks found within 60 s and the median delay (Monte Carlo). Steps add a little
 more (docs/detection.md: the step integral, 0.4-1.7 spreads per step with integral action only).
 
-Usage: pressure_information_bound.py LEAKMON [WORKDIR]   (LEAKMON: build/bin/leakmon)
+Usage: pressure_information_bound.py LEAKMON [WORKDIR] [--friction F_C]   (LEAKMON: build/bin/leakmon)
+  --friction F_C: the nominal rig only, with MODEL.md's coulomb_friction of F_C newtons, leaks
+  up to 5e-12 (docs/detection.md, "A rig the pressures cannot see a leak on")
 """
 import io
 import math
@@ -54,8 +56,10 @@ RIGS = {  # MODEL.md's nominal rig and corners of its calibration spread
 LEAKS = (5e-13, 1e-12, 2e-12)
 
 
-def simulate(leakmon, workdir, rig, params, controller, leak):
+def simulate(leakmon, workdir, rig, params, controller, leak, friction=0.0):
     name = f"{rig.replace(' ', '').replace('%', 'pc').replace('/', '')}_{controller}_{leak:g}"
+    if friction:
+        name += f"_F{friction:g}"
     scenario = os.path.join(workdir, name + ".yaml")
     capture = os.path.join(workdir, name + ".csv")
     if not os.path.exists(capture):
@@ -63,8 +67,13 @@ def simulate(leakmon, workdir, rig, params, controller, leak):
             out.write(f"name: bound\ncontroller: {controller}\nduration_s: {SECONDS}\nseed: {SEED}\n")
             if params:
                 out.write("params: {" + ", ".join(f"{k}: {v}" for k, v in params.items()) + "}\n")
+            effects = []
+            if friction:
+                effects.append(f"  coulomb_friction: {{F_C: {friction}}}")
             if leak > 0:
-                out.write(f"effects:\n  internal_leakage: {{C_L: {leak}, onset_s: 0.002, ramp_s: 0}}\n")
+                effects.append(f"  internal_leakage: {{C_L: {leak}, onset_s: 0.002, ramp_s: 0}}")
+            if effects:
+                out.write("effects:\n" + "\n".join(effects) + "\n")
         subprocess.run([leakmon, "sim", "--scenario", scenario, "--out", capture], check=True,
                        stdout=subprocess.DEVNULL)
     lines = [line for line in open(capture) if not line.startswith("#")]
@@ -144,18 +153,28 @@ def ideal_detection(shift, rng, runs=4000, horizon_s=60.0):
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    leakmon = sys.argv[1]
-    workdir = sys.argv[2] if len(sys.argv) > 2 else "/tmp/pressure_information_bound"
+    args = sys.argv[1:]
+    friction = 0.0
+    if "--friction" in args:
+        k = args.index("--friction")
+        friction = float(args[k + 1])
+        del args[k:k + 2]
+    leakmon = args[0]
+    workdir = args[1] if len(args) > 1 else "/tmp/pressure_information_bound"
+    rigs = {"nominal": {}} if friction else RIGS
+    leaks = (1e-12, 2e-12, 5e-12) if friction else LEAKS
     os.makedirs(workdir, exist_ok=True)
     rng = np.random.default_rng(1)
     print("| rig | controller | C_L | chambers | stationary KL (nats/s) | per block, level known "
           "| per block, level unknown | ideal CUSUM: found within 60 s, median |")
     print("|---|---|---|---|---|---|---|---|")
-    for rig, params in RIGS.items():
+    for rig, params in rigs.items():
         for controller in ("basic", "fault_tolerant"):
-            healthy, healthy_hold = periodograms(simulate(leakmon, workdir, rig, params, controller, 0.0))
-            for leak in LEAKS:
-                leaky, leaky_hold = periodograms(simulate(leakmon, workdir, rig, params, controller, leak))
+            healthy, healthy_hold = periodograms(
+                simulate(leakmon, workdir, rig, params, controller, 0.0, friction))
+            for leak in leaks:
+                leaky, leaky_hold = periodograms(
+                    simulate(leakmon, workdir, rig, params, controller, leak, friction))
                 for chambers, sel in (("p1, p2", slice(0, 2)), ("p1", slice(0, 1))):
                     h_all = healthy[:, :, sel, sel].mean(0)
                     l_all = leaky[:, :, sel, sel].mean(0)
