@@ -13,6 +13,11 @@ the 0.8 s blocks (p_L range below the median, linear trend removed, Hann window)
 the Fisher distance per block along the leak's change, with the block's level unknown. The change
 is estimated from two halves of the blocks and multiplied, as in pressure_information_bound.py.
 
+A second table gives the mean shift, in healthy standard deviations of one quiet block, of two
+simple features of the detrended p_L. The first is the high-frequency share,
+ln(var(diff p_L) / var p_L), which is level-free. The second is ln var p_L, which follows the
+excitation level.
+
 Usage: friction_compliance_lead.py LEAKMON [WORKDIR]   (LEAKMON: build/bin/leakmon)
 """
 import io
@@ -54,6 +59,19 @@ def capture(leakmon, workdir, controller, friction, leak):
                          usecols=(names.index("p1"), names.index("p2")))
 
 
+def block_features(pressures):
+    """Per block: ln(var of the first difference / var) and ln var of the detrended p_L."""
+    n = len(pressures) // BLOCK
+    x = pressures[: n * BLOCK].reshape(n, BLOCK, 2)
+    p_l = x[:, :, 0] - x[:, :, 1]
+    t = np.arange(BLOCK)
+    design = np.vstack([np.ones(BLOCK), t]).T
+    residual = p_l - (design @ np.linalg.lstsq(design, p_l.T, rcond=None)[0]).T
+    variance = (residual * residual).mean(1)
+    step = np.diff(residual, axis=1)
+    return np.log((step * step).mean(1) / variance), np.log(variance)
+
+
 def block_spectra(pressures):
     n = len(pressures) // BLOCK
     x = pressures[: n * BLOCK].reshape(n, BLOCK, 2)
@@ -86,14 +104,28 @@ def main():
     band = (f >= 1.0) & (f <= 40.0)
     print("| controller | " + " | ".join(f"{F} N" if F else "no friction" for F in FRICTIONS) + " |")
     print("|---" * (len(FRICTIONS) + 1) + "|")
+    shifts = {}
     for controller in ("basic", "fault_tolerant"):
         row = []
         for friction in FRICTIONS:
-            healthy, spread_h = block_spectra(capture(leakmon, workdir, controller, friction, 0.0))
-            leaky, spread_l = block_spectra(capture(leakmon, workdir, controller, friction, LEAK))
+            healthy_capture = capture(leakmon, workdir, controller, friction, 0.0)
+            leaky_capture = capture(leakmon, workdir, controller, friction, LEAK)
+            healthy, spread_h = block_spectra(healthy_capture)
+            leaky, spread_l = block_spectra(leaky_capture)
             threshold = np.median(spread_h)
-            row.append(distance(healthy, leaky, spread_h < threshold, spread_l < threshold, band))
+            quiet_h, quiet_l = spread_h < threshold, spread_l < threshold
+            row.append(distance(healthy, leaky, quiet_h, quiet_l, band))
+            for name, h, l in zip(("high-frequency share", "ln var"),
+                                  block_features(healthy_capture), block_features(leaky_capture)):
+                a, b = h[quiet_h], l[quiet_l]
+                shifts.setdefault((name, controller), []).append((b.mean() - a.mean()) / a.std())
         print(f"| {controller} | " + " | ".join(f"{d:.2f}" for d in row) + " |", flush=True)
+    print()
+    print("| feature | controller | " + " | ".join(f"{F} N" if F else "no friction" for F in FRICTIONS)
+          + " |")
+    print("|---|---" + "|---" * len(FRICTIONS) + "|")
+    for (name, controller), values in shifts.items():
+        print(f"| {name} | {controller} | " + " | ".join(f"{v:+.2f}" for v in values) + " |")
 
 
 if __name__ == "__main__":
