@@ -391,6 +391,7 @@ std::string OperatorView::trend_json(double since) const {
     item.string("state", to_string(a.state));
     item.boolean("learning", a.learning);
     item.boolean("suspended", a.suspended);
+    item.boolean("detection_blind", a.detection_blind);
     item.number("t", a.t);
     item.number("index_p1", a.index_p1);
     item.number("index_p2", a.index_p2);

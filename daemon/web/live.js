@@ -96,11 +96,17 @@ function createActuator(a) {
   const alarm = el("span", "badge alarm-state", "");
   const learning = el("span", "badge", "learning");
   const suspended = el("span", "badge warn", "decision held: sensor fault");
+  // A pressure-only detector on a rig whose hydraulic mode did not show while it learned: it
+  // cannot raise a leak alarm, which must not look like a healthy rig.
+  const blind = el("span", "badge warn blind", "blind: no hydraulic mode in the pressures");
+  blind.title = "The pressure-only detector sees a leak through the hydraulic mode, which " +
+    "hardly showed above the transducer noise while it learned (seal friction, much air). " +
+    "No leak alarm can come from it; acquire the valve command and the position.";
   const ack = el("button", "ack", "Acknowledge");
   ack.type = "button";
   ack.addEventListener("click", () => acknowledge(a.name, result));
   const result = el("span", "ack-result", "");
-  title.append(alarm, learning, suspended, ack, result);
+  title.append(alarm, learning, suspended, blind, ack, result);
   card.appendChild(title);
 
   const tiles = el("div", "tiles");
@@ -126,7 +132,9 @@ function createActuator(a) {
   for (const name of TREND_COLUMNS) data[name] = [];
   const kpa = (v) => scaled(v, 1e3);
   const mpa = (v) => scaled(v, 1e6);
-  const entry = { card, alarm, learning, suspended, ack, result, tiles: t, data, charts: [] };
+  const entry = {
+    card, alarm, learning, suspended, blind, ack, result, tiles: t, data, charts: [],
+  };
   entry.build = [
     () => [data.time, data.index_p1.map(kpa), data.index_p2.map(kpa)],
     () => [data.time, data.score, data.raise_threshold],
@@ -167,6 +175,7 @@ function updateActuator(a) {
   card.classList.toggle("alarmed", a.state !== "normal");
   entry.learning.hidden = !a.learning;
   entry.suspended.hidden = !a.suspended;
+  entry.blind.hidden = !a.detection_blind;
   entry.ack.disabled = a.state === "normal";
   tiles.index.value.textContent =
     fmt(scaled(a.index_p1, 1e3), 2) + " / " + fmt(scaled(a.index_p2, 1e3), 2);

@@ -5,7 +5,9 @@ Starts `leakmon run` on the simulated rig (a 0.15 l/min/MPa leak opens at 20 s, 
 learns from 2 s to 14 s), opens http://127.0.0.1:PORT/ and checks, as an operator would see it:
 the page loads everything from the daemon only and logs no console error (CSP violations
 included), the trend advances, the leak alarm appears after the leak, and the page's
-Acknowledge button changes the daemon's alarm state (read back from /metrics). Optionally saves
+Acknowledge button changes the daemon's alarm state (read back from /metrics). A second,
+pressure-only actuator on a rig held by seal friction must show the "blind" badge once it has
+learned, and the first actuator must not. Optionally saves
 a screenshot with the raised alarm (docs/figures/live-page.png is made this way).
 
     live_page_test.py --leakmon build/bin/leakmon --workdir DIR [--screenshot FILE.png]
@@ -24,6 +26,14 @@ from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 
 LEAK_ONSET_S = 20.0
+FRICTION_SCENARIO = """\
+name: press-held-by-seal-friction
+controller: basic
+duration_s: 3600
+seed: 9
+effects:
+  coulomb_friction: {F_C: 120}
+"""
 
 CONFIG = """\
 drivers:
@@ -32,14 +42,20 @@ drivers:
     scenario: healthy
     seed: 7
     leak: {{lpm_per_mpa: 0.15, onset_s: {onset}, ramp_s: 1}}
+  - name: press_rig
+    type: sim
+    scenario: {friction_scenario}
 sampling:
-  - {{name: main, period_ms: 2, drivers: [rig], priority: 0}}
+  - {{name: main, period_ms: 2, drivers: [rig, press_rig], priority: 0}}
 actuators:
   - name: cylinder
     channels: {{p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x, xref: rig.xref}}
     features: {{wavelet: db8, level: 2, window: 400, step: 20, mode: symmetric}}
     detector: {{kind: default, options: {{settle_seconds: 2, learn_seconds: 12}}}}
     alarm: {{on_delay_s: 1, off_delay_s: 10, latching: false}}
+  - name: press
+    channels: {{p1: press_rig.p1, p2: press_rig.p2}}
+    detector: {{kind: default, options: {{settle_seconds: 2, learn_seconds: 12}}}}
 events: {{log: events.jsonl}}
 metrics: {{port: {port}, trend_interval_s: 0.5}}
 state: {{directory: ""}}
@@ -91,8 +107,11 @@ def main():
     os.makedirs(args.workdir, exist_ok=True)
     port = free_port()
     config = os.path.join(args.workdir, "leakmon.yaml")
+    friction_scenario = os.path.join(args.workdir, "press.yaml")
+    with open(friction_scenario, "w") as f:
+        f.write(FRICTION_SCENARIO)
     with open(config, "w") as f:
-        f.write(CONFIG.format(onset=LEAK_ONSET_S, port=port))
+        f.write(CONFIG.format(onset=LEAK_ONSET_S, port=port, friction_scenario=friction_scenario))
     events = os.path.join(args.workdir, "events.jsonl")
     if os.path.exists(events):
         os.remove(events)
@@ -139,6 +158,14 @@ def main():
                  lambda: driver.find_elements(By.CSS_SELECTOR, "#events tr.alarm_raised"), 10)
         leak = card.find_element(By.CSS_SELECTOR, ".leak").text
         assert "±" in leak, f"leak size without its interval: {leak!r}"
+        press = driver.find_element(By.ID, "actuator-press")
+        wait_for("the blind badge of the friction-held, pressure-only actuator",
+                 lambda: press.find_element(By.CSS_SELECTOR, ".badge.blind").is_displayed(), 15)
+        assert not card.find_element(By.CSS_SELECTOR, ".badge.blind").is_displayed(), \
+            "the flow-balance actuator is shown blind"
+        with open(events) as f:
+            assert '"event": "detection_blind", "actuator": "press"' in f.read(), \
+                "no detection_blind event for the press"
         # Let the charts draw the alarm's surroundings before the picture.
         wait_for("two more trend points",
                  lambda: int(card.get_attribute("data-points")) > later + 6, 10)
