@@ -410,14 +410,15 @@ void ActuatorMonitor::import_state(const ActuatorState& state) {
     throw;
   }
   alarm_.restore(state.alarm, state.alarm_condition);
-  // The verdict of the learning period the state comes from; a state without one (older, or
-  // saved before learning ended) stays unjudged: later hops may carry a leak.
-  mode_judged_ = true;
-  healthy_index_ratio_ = state.healthy_index_ratio;
-  announce_blind_ = detection_blind();
   detector_->resume_after_gap();
   detect::Observation gap;
   last_decision_ = detector_->update(gap);
+  // The verdict of the learning period the state comes from. A detector still learning is
+  // judged when it is done; one that has learned without a verdict (a format-1 state) stays
+  // unjudged, since later hops may carry a leak.
+  healthy_index_ratio_ = state.healthy_index_ratio;
+  mode_judged_ = std::isfinite(healthy_index_ratio_) || !last_decision_.learning;
+  announce_blind_ = mode_judged_ && detection_blind();
   last_decision_.score = kNaN;
 }
 

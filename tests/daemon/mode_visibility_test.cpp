@@ -110,6 +110,35 @@ TEST(ModeVisibilityReplay, SealFrictionIsAnnouncedAtTheEndOfLearningAndAfterARes
   std::filesystem::remove_all(directory);
 }
 
+// A restart in the middle of learning: the verdict comes when the resumed learning ends.
+TEST(ModeVisibilityReplay, ARestartWhileLearningIsJudgedWhenLearningEnds) {
+  const capture::Capture stuck = pressure_capture(80.0, 240.0, 9);
+  const DaemonConfig config = default_replay_config(stuck);
+  const auto directory = std::filesystem::temp_directory_path() /
+                         ("leakmon-mode-learning-" +
+                          std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  std::filesystem::remove_all(directory);
+  ReplayOptions options;
+  options.state_directory = directory.string();
+  capture::Capture first = stuck, rest = stuck;
+  const auto& t = stuck.column("t");
+  const std::size_t cut =
+      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), 40.0) - t.begin());
+  for (std::size_t c = 0; c < stuck.columns.size(); ++c) {
+    first.values[c].resize(cut);
+    rest.values[c].erase(rest.values[c].begin(), rest.values[c].begin() + cut);
+  }
+  const ReplayResult before = replay_capture(first, config, options);
+  const ReplayResult after = replay_capture(rest, config, options);
+  std::filesystem::remove_all(directory);
+  EXPECT_TRUE(blind_events(before).empty());
+  ASSERT_EQ(before.learned.size(), 1u);
+  EXPECT_TRUE(std::isnan(before.learned.front().healthy_index_ratio));
+  EXPECT_EQ(blind_events(after).size(), 1u);
+  ASSERT_EQ(after.actuators.size(), 1u);
+  EXPECT_TRUE(after.actuators.front().detection_blind);
+}
+
 TEST(ModeVisibilityReplay, AHealthyRigIsNotBlindAndTheFlowBalanceIsNotJudged) {
   const capture::Capture healthy = pressure_capture(0.0, 200.0, 7);
   const ReplayResult result = replay_capture(healthy, default_replay_config(healthy));
