@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,6 +17,8 @@
 #include "daemon/state_store.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/capture_slices.hpp"
+#include "tests/support/paths.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -56,14 +57,7 @@ capture::Capture pressure_capture(double friction, double seconds, unsigned seed
     const sim::EffectParameter params[] = {{"F_C", friction}};
     scenario.effects.enable("coulomb_friction", params);
   }
-  const capture::Capture full = sim::simulate(scenario);
-  capture::Capture pressures;
-  pressures.metadata = full.metadata;
-  for (const char* name : {"t", "p1", "p2"}) {
-    pressures.columns.push_back(name);
-    pressures.values.push_back(full.column(name));
-  }
-  return pressures;
+  return test::columns_of(sim::simulate(scenario), {"t", "p1", "p2"});
 }
 
 std::vector<io::Event> blind_events(const ReplayResult& result) {
@@ -93,12 +87,8 @@ TEST(ModeVisibilityReplay, SealFrictionIsAnnouncedAtTheEndOfLearningAndAfterARes
   }
 
   // A restart keeps the verdict of the learning period and says it again.
-  const auto directory =
-      std::filesystem::temp_directory_path() /
-      ("leakmon-mode-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::remove_all(directory);
   ReplayOptions options;
-  options.state_directory = directory.string();
+  options.state_directory = test::scratch_dir("mode_visibility_restart");
   replay_capture(stuck, config, options);
   const ReplayResult resumed = replay_capture(pressure_capture(80.0, 30.0, 8), config, options);
   const auto again = blind_events(resumed);
@@ -107,30 +97,16 @@ TEST(ModeVisibilityReplay, SealFrictionIsAnnouncedAtTheEndOfLearningAndAfterARes
   ASSERT_EQ(resumed.learned.size(), 1u);
   EXPECT_NEAR(resumed.learned.front().healthy_index_ratio, result.actuators.front().mode_visibility,
               1e-9);
-  std::filesystem::remove_all(directory);
 }
 
 // A restart in the middle of learning: the verdict comes when the resumed learning ends.
 TEST(ModeVisibilityReplay, ARestartWhileLearningIsJudgedWhenLearningEnds) {
   const capture::Capture stuck = pressure_capture(80.0, 240.0, 9);
   const DaemonConfig config = default_replay_config(stuck);
-  const auto directory = std::filesystem::temp_directory_path() /
-                         ("leakmon-mode-learning-" +
-                          std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::remove_all(directory);
   ReplayOptions options;
-  options.state_directory = directory.string();
-  capture::Capture first = stuck, rest = stuck;
-  const auto& t = stuck.column("t");
-  const std::size_t cut =
-      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), 40.0) - t.begin());
-  for (std::size_t c = 0; c < stuck.columns.size(); ++c) {
-    first.values[c].resize(cut);
-    rest.values[c].erase(rest.values[c].begin(), rest.values[c].begin() + cut);
-  }
-  const ReplayResult before = replay_capture(first, config, options);
-  const ReplayResult after = replay_capture(rest, config, options);
-  std::filesystem::remove_all(directory);
+  options.state_directory = test::scratch_dir("mode_visibility_restart_while_learning");
+  const ReplayResult before = replay_capture(test::rows_between(stuck, 0.0, 40.0), config, options);
+  const ReplayResult after = replay_capture(test::rows_between(stuck, 40.0, 1e9), config, options);
   EXPECT_TRUE(blind_events(before).empty());
   ASSERT_EQ(before.learned.size(), 1u);
   EXPECT_TRUE(std::isnan(before.learned.front().healthy_index_ratio));

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
@@ -16,6 +15,7 @@
 #include "daemon/replay.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/capture_slices.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon::daemon {
@@ -27,32 +27,6 @@ const capture::Capture& morning() {
   static const capture::Capture capture =
       sim::simulate(sim::load_scenario(test::source_dir() + "/sim/scenarios/morning-start.yaml"));
   return capture;
-}
-
-// The rows of `capture` with from <= t < to, every column kept.
-capture::Capture rows_between(const capture::Capture& capture, double from, double to) {
-  capture::Capture out;
-  out.metadata = capture.metadata;
-  out.columns = capture.columns;
-  out.values.resize(capture.columns.size());
-  const auto& t = capture.column("t");
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < from || t[i] >= to) continue;
-    for (std::size_t c = 0; c < capture.columns.size(); ++c) {
-      out.values[c].push_back(capture.values[c][i]);
-    }
-  }
-  return out;
-}
-
-capture::Capture only(const capture::Capture& capture, std::initializer_list<const char*> names) {
-  capture::Capture out;
-  out.metadata = capture.metadata;
-  for (const char* name : names) {
-    out.columns.push_back(name);
-    out.values.push_back(capture.column(name));
-  }
-  return out;
 }
 
 std::vector<double> leak_alarm_times(const std::vector<io::Event>& events) {
@@ -92,17 +66,14 @@ TEST(MorningStart, EveryChannelNamesItsFaultAndOnlyTheLeakIsALeak) {
 }
 
 TEST(MorningStart, ARestartHalfWayKeepsWhatWasLearnedAndStillFindsTheLeak) {
-  const auto directory =
-      std::filesystem::temp_directory_path() /
-      ("leakmon-morning-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::remove_all(directory);
   ReplayOptions options;
-  options.state_directory = directory.string();
+  options.state_directory = test::scratch_dir("morning_start_restart");
   const DaemonConfig config = default_replay_config(morning());
   // Down from 520 s to 540 s, in the middle of the warm-up.
-  const ReplayResult before = replay_capture(rows_between(morning(), 0.0, 520.0), config, options);
-  const ReplayResult after = replay_capture(rows_between(morning(), 540.0, 1e9), config, options);
-  std::filesystem::remove_all(directory);
+  const ReplayResult before =
+      replay_capture(test::rows_between(morning(), 0.0, 520.0), config, options);
+  const ReplayResult after =
+      replay_capture(test::rows_between(morning(), 540.0, 1e9), config, options);
   EXPECT_TRUE(leak_alarm_times(before.events).empty());
   EXPECT_TRUE(has(after.events, io::EventKind::state_restored));
   const auto alarms = leak_alarm_times(after.events);
@@ -113,7 +84,7 @@ TEST(MorningStart, ARestartHalfWayKeepsWhatWasLearnedAndStillFindsTheLeak) {
 }
 
 TEST(MorningStart, PressuresOnlySayTheyCannotSeeALeakInsteadOfStayingSilent) {
-  const capture::Capture pressures = only(morning(), {"t", "p1", "p2"});
+  const capture::Capture pressures = test::columns_of(morning(), {"t", "p1", "p2"});
   const ReplayResult result = replay_capture(pressures, default_replay_config(pressures));
   EXPECT_TRUE(leak_alarm_times(result.events).empty());
   EXPECT_FALSE(has(result.events, io::EventKind::driver_fault));

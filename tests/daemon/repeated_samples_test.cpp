@@ -12,6 +12,7 @@
 #include "daemon/replay.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/capture_slices.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -75,13 +76,7 @@ TEST(RepeatedSampleCheck, OneChannelAloneIsNotJudgedAndGapsAreNoRepeats) {
 TEST(RepeatedSamplesReplay, AHeldStreamHoldsTheDecisionInsteadOfRaisingALeak) {
   sim::Scenario scenario = sim::preset("healthy", 5);
   scenario.duration_s = 400.0;
-  const capture::Capture full = sim::simulate(scenario);
-  capture::Capture pressures;
-  pressures.metadata = full.metadata;
-  for (const char* name : {"t", "p1", "p2"}) {
-    pressures.columns.push_back(name);
-    pressures.values.push_back(full.column(name));
-  }
+  capture::Capture pressures = test::columns_of(sim::simulate(scenario), {"t", "p1", "p2"});
   capture::Capture held = pressures;
   for (const char* name : {"p1", "p2"}) {
     auto& v = held.column(name);
@@ -116,13 +111,7 @@ TEST(RepeatedSamplesReplay, AFrozenChannelIsASensorFaultNotARepeatingAcquisition
   scenario.duration_s = 200.0;
   const sim::EffectParameter friction[] = {{"F_C", 120.0}};
   scenario.effects.enable("coulomb_friction", friction);
-  const capture::Capture full = sim::simulate(scenario);
-  capture::Capture pressures;
-  pressures.metadata = full.metadata;
-  for (const char* name : {"t", "p1", "p2"}) {
-    pressures.columns.push_back(name);
-    pressures.values.push_back(full.column(name));
-  }
+  capture::Capture pressures = test::columns_of(sim::simulate(scenario), {"t", "p1", "p2"});
   auto& p1 = pressures.column("p1");
   for (std::size_t i = 150 * 500; i < 158 * 500; ++i) p1[i] = p1[150 * 500 - 1];
 
