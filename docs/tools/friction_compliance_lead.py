@@ -11,7 +11,8 @@ For each controller and friction the tool simulates a healthy capture and one wi
 from the start, with the same seed. It takes the p_L spectrum over 1-40 Hz in the quieter half of
 the 0.8 s blocks (p_L range below the median, linear trend removed, Hann window). It then computes
 the Fisher distance per block along the leak's change, with the block's level unknown. The change
-is estimated from two halves of the blocks and multiplied, as in pressure_information_bound.py.
+is estimated from two halves of the blocks and multiplied (pressure_information_bound.py's
+block_information, which also simulates the captures).
 
 A second table gives the mean shift, in healthy standard deviations of one quiet block, of two
 simple features of the detrended p_L. The first is the high-frequency share,
@@ -20,78 +21,40 @@ excitation level.
 
 Usage: friction_compliance_lead.py LEAKMON [WORKDIR]   (LEAKMON: build/bin/leakmon)
 """
-import io
-import math
 import os
-import subprocess
 import sys
 
 import numpy as np
 
-BLOCK = 400
-FS = 500.0
-SECONDS = 1200
-SEED = 5
+import pressure_information_bound as bound  # the simulation and the Fisher distance
+
+BLOCK = bound.BLOCK
+FS = bound.FS
 LEAK = 1e-12
 FRICTIONS = (0, 50, 120, 400)
-HANN_BINS_PER_INDEPENDENT = 1.5
 
 
-def capture(leakmon, workdir, controller, friction, leak):
-    name = f"{controller}_F{friction}_L{leak:g}"
-    path = os.path.join(workdir, name + ".csv")
-    if not os.path.exists(path):
-        scenario = os.path.join(workdir, name + ".yaml")
-        effects = []
-        if friction:
-            effects.append(f"  coulomb_friction: {{F_C: {friction}}}")
-        if leak:
-            effects.append(f"  internal_leakage: {{C_L: {leak}, onset_s: 0.002, ramp_s: 0}}")
-        with open(scenario, "w") as out:
-            out.write(f"name: lead\ncontroller: {controller}\nduration_s: {SECONDS}\nseed: {SEED}\n")
-            if effects:
-                out.write("effects:\n" + "\n".join(effects) + "\n")
-        subprocess.run([leakmon, "sim", "--scenario", scenario, "--out", path], check=True,
-                       stdout=subprocess.DEVNULL)
-    lines = [line for line in open(path) if not line.startswith("#")]
-    names = lines[0].strip().split(",")
-    return np.genfromtxt(io.StringIO("".join(lines[1:])), delimiter=",",
-                         usecols=(names.index("p1"), names.index("p2")))
-
-
-def block_features(pressures):
-    """Per block: ln(var of the first difference / var) and ln var of the detrended p_L."""
+def detrended_p_l(pressures):
+    """Per 0.8 s block: p_L with its linear trend removed, and p_L's range (max - min)."""
     n = len(pressures) // BLOCK
     x = pressures[: n * BLOCK].reshape(n, BLOCK, 2)
     p_l = x[:, :, 0] - x[:, :, 1]
-    t = np.arange(BLOCK)
-    design = np.vstack([np.ones(BLOCK), t]).T
+    design = np.vstack([np.ones(BLOCK), np.arange(BLOCK)]).T
     residual = p_l - (design @ np.linalg.lstsq(design, p_l.T, rcond=None)[0]).T
+    return residual, p_l.max(1) - p_l.min(1)
+
+
+def block_features(residual):
+    """Per block: ln(var of the first difference / var) and ln var of the detrended p_L."""
     variance = (residual * residual).mean(1)
     step = np.diff(residual, axis=1)
     return np.log((step * step).mean(1) / variance), np.log(variance)
 
 
-def block_spectra(pressures):
-    n = len(pressures) // BLOCK
-    x = pressures[: n * BLOCK].reshape(n, BLOCK, 2)
-    p_l = x[:, :, 0] - x[:, :, 1]
-    spread = p_l.max(1) - p_l.min(1)
-    t = np.arange(BLOCK)
-    design = np.vstack([np.ones(BLOCK), t]).T
-    trend = design @ np.linalg.lstsq(design, p_l.T, rcond=None)[0]
-    residual = p_l - trend.T
+def block_spectra(residual):
+    """Per block: the Hann-windowed periodogram of the detrended p_L, as 1x1 matrices."""
     spectra = np.abs(np.fft.rfft(residual * np.hanning(BLOCK)[None, :], axis=1)) ** 2
-    return spectra, spread
-
-
-def distance(healthy, leaky, quiet_h, quiet_l, band):
-    s0 = healthy[quiet_h].mean(0)
-    ih, il = np.where(quiet_h)[0], np.where(quiet_l)[0]
-    a = ((leaky[il[: len(il) // 2]].mean(0) - healthy[ih[: len(ih) // 2]].mean(0)) / s0)[band]
-    b = ((leaky[il[len(il) // 2:]].mean(0) - healthy[ih[len(ih) // 2:]].mean(0)) / s0)[band]
-    d2 = ((a * b).sum() - a.sum() * b.sum() / len(a)) / HANN_BINS_PER_INDEPENDENT
-    return math.sqrt(max(d2, 0.0))
+    return spectra[:, :, None, None]
 
 
 def main():
@@ -108,17 +71,17 @@ def main():
     for controller in ("basic", "fault_tolerant"):
         row = []
         for friction in FRICTIONS:
-            healthy_capture = capture(leakmon, workdir, controller, friction, 0.0)
-            leaky_capture = capture(leakmon, workdir, controller, friction, LEAK)
-            healthy, spread_h = block_spectra(healthy_capture)
-            leaky, spread_l = block_spectra(leaky_capture)
+            healthy, spread_h = detrended_p_l(
+                bound.simulate(leakmon, workdir, "nominal", {}, controller, 0.0, friction))
+            leaky, spread_l = detrended_p_l(
+                bound.simulate(leakmon, workdir, "nominal", {}, controller, LEAK, friction))
             threshold = np.median(spread_h)
             quiet_h, quiet_l = spread_h < threshold, spread_l < threshold
-            row.append(distance(healthy, leaky, quiet_h, quiet_l, band))
+            row.append(bound.block_information(block_spectra(healthy[quiet_h])[:, band],
+                                               block_spectra(leaky[quiet_l])[:, band])[1])
             for name, h, l in zip(("high-frequency share", "ln var"),
-                                  block_features(healthy_capture), block_features(leaky_capture)):
-                a, b = h[quiet_h], l[quiet_l]
-                shifts.setdefault((name, controller), []).append((b.mean() - a.mean()) / a.std())
+                                  block_features(healthy[quiet_h]), block_features(leaky[quiet_l])):
+                shifts.setdefault((name, controller), []).append((l.mean() - h.mean()) / h.std())
         print(f"| {controller} | " + " | ".join(f"{d:.2f}" for d in row) + " |", flush=True)
     print()
     print("| feature | controller | " + " | ".join(f"{F} N" if F else "no friction" for F in FRICTIONS)
