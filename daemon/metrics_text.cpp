@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <span>
 #include <stdexcept>
+#include <type_traits>
 
 #include "capture/units.hpp"
 #include "daemon/daemon.hpp"
@@ -98,6 +100,23 @@ void latency_histogram(PrometheusText& out, std::string_view name, std::string_v
 
 std::uint64_t flag(bool on) { return on ? 1 : 0; }
 
+// A gauge family with one sample per actuator, `value(actuator)`. With `skip_missing`, an
+// actuator whose value is not finite gets no sample: the quantity does not exist there (no
+// temperature transducer, a detector that is not judged), which NaN would misstate.
+template <typename ValueOf>
+void per_actuator_gauge(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+                        std::string_view name, std::string_view help, ValueOf value,
+                        bool skip_missing = false) {
+  out.family(name, help, "gauge");
+  for (const auto& a : actuators) {
+    const auto v = value(a);
+    if constexpr (std::is_floating_point_v<decltype(v)>) {
+      if (skip_missing && !std::isfinite(v)) continue;
+    }
+    out.sample(name, label("actuator", a.name), v);
+  }
+}
+
 }  // namespace
 
 void state_set(PrometheusText& out, std::string_view name, std::string_view labels,
@@ -127,19 +146,13 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
     out.sample("leakmon_detector_score",
                label("actuator", a.name) + "," + label("detector", a.detector), a.score);
   }
-  out.family("leakmon_detector_learning", "1 while the detector learns the healthy baseline",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_detector_learning", label("actuator", a.name), flag(a.learning));
-  }
-  out.family("leakmon_learning_remaining_seconds",
-             "source time until the detector decides (0: it decides; after a reload that "
-             "invalidated what it learned, until it has learned again)",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_learning_remaining_seconds", label("actuator", a.name),
-               a.learning_seconds_left);
-  }
+  per_actuator_gauge(out, actuators, "leakmon_detector_learning",
+                     "1 while the detector learns the healthy baseline",
+                     [](const ActuatorStatus& a) { return flag(a.learning); });
+  per_actuator_gauge(out, actuators, "leakmon_learning_remaining_seconds",
+                     "source time until the detector decides (0: it decides; after a reload that "
+                     "invalidated what it learned, until it has learned again)",
+                     [](const ActuatorStatus& a) { return a.learning_seconds_left; });
   out.family("leakmon_relearn_total",
              "reloads that changed an option the learned state depends on (learning started over)",
              "counter");
@@ -155,25 +168,18 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   }
   // FORMATS.md "Operator view and fleet": the leak size in l/min/MPa (at 40 degC where the oil
   // temperature is acquired), NaN until the detector has one; its 95 % half-width beside it.
-  out.family("leakmon_leak_lpm_per_mpa",
-             "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel", "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_leak_lpm_per_mpa", label("actuator", a.name),
-               units::lpm_per_mpa(a.leak_coefficient));
-  }
-  out.family("leakmon_leak_lpm_per_mpa_ci95", "95 % half-width of the leak size [l/min/MPa]",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_leak_lpm_per_mpa_ci95", label("actuator", a.name),
-               units::lpm_per_mpa(a.leak_coefficient_ci));
-  }
-  out.family("leakmon_oil_temperature_celsius", "oil temperature (hop mean of the temp channel)",
-             "gauge");
-  for (const auto& a : actuators) {
-    if (std::isfinite(a.oil_temperature)) {
-      out.sample("leakmon_oil_temperature_celsius", label("actuator", a.name), a.oil_temperature);
-    }
-  }
+  per_actuator_gauge(
+      out, actuators, "leakmon_leak_lpm_per_mpa",
+      "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel",
+      [](const ActuatorStatus& a) { return units::lpm_per_mpa(a.leak_coefficient); });
+  per_actuator_gauge(out, actuators, "leakmon_leak_lpm_per_mpa_ci95",
+                     "95 % half-width of the leak size [l/min/MPa]", [](const ActuatorStatus& a) {
+                       return units::lpm_per_mpa(a.leak_coefficient_ci);
+                     });
+  per_actuator_gauge(
+      out, actuators, "leakmon_oil_temperature_celsius",
+      "oil temperature (hop mean of the temp channel)",
+      [](const ActuatorStatus& a) { return a.oil_temperature; }, true);
   out.family("leakmon_sensor_status", "NAMUR NE 107 status of each transducer channel (1: current)",
              "gauge");
   for (const auto& a : actuators) {
@@ -190,35 +196,23 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
                  label("actuator", a.name) + "," + label("channel", c.channel), c.spikes_rejected);
     }
   }
-  out.family("leakmon_detector_suspended", "1 while a faulty channel holds the leak decision",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_detector_suspended", label("actuator", a.name), flag(a.suspended));
-  }
-  out.family("leakmon_acquisition_repeated_samples",
-             "samples of the last second that repeat the one before exactly (100 of 500: the "
-             "acquisition is slower than its sampling, and the leak decision is held)",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_acquisition_repeated_samples", label("actuator", a.name),
-               static_cast<double>(a.repeated_samples));
-  }
-  out.family("leakmon_hydraulic_mode_visibility",
-             "pressure-only detectors: median index while learning over the transducer's noise "
-             "floor, best chamber (below 2.5 the rig is blind to a leak: detection_blind)",
-             "gauge");
-  for (const auto& a : actuators) {
-    if (std::isfinite(a.mode_visibility)) {
-      out.sample("leakmon_hydraulic_mode_visibility", label("actuator", a.name), a.mode_visibility);
-    }
-  }
-  out.family("leakmon_detection_blind",
-             "1 when a pressure-only detector's rig showed no hydraulic mode to see a leak by "
-             "while it learned",
-             "gauge");
-  for (const auto& a : actuators) {
-    out.sample("leakmon_detection_blind", label("actuator", a.name), flag(a.detection_blind));
-  }
+  per_actuator_gauge(out, actuators, "leakmon_detector_suspended",
+                     "1 while a faulty channel holds the leak decision",
+                     [](const ActuatorStatus& a) { return flag(a.suspended); });
+  per_actuator_gauge(
+      out, actuators, "leakmon_acquisition_repeated_samples",
+      "samples of the last second that repeat the one before exactly (100 of 500: the "
+      "acquisition is slower than its sampling, and the leak decision is held)",
+      [](const ActuatorStatus& a) { return static_cast<double>(a.repeated_samples); });
+  per_actuator_gauge(
+      out, actuators, "leakmon_hydraulic_mode_visibility",
+      "pressure-only detectors: median index while learning over the transducer's noise floor, "
+      "best chamber (below 2.5 the rig is blind to a leak: detection_blind)",
+      [](const ActuatorStatus& a) { return a.mode_visibility; }, true);
+  per_actuator_gauge(out, actuators, "leakmon_detection_blind",
+                     "1 when a pressure-only detector's rig showed no hydraulic mode to see a "
+                     "leak by while it learned",
+                     [](const ActuatorStatus& a) { return flag(a.detection_blind); });
   out.family("leakmon_learned_state_age_seconds",
              "seconds since the learned state kept in the state directory was saved", "gauge");
   for (const auto& a : actuators) {
