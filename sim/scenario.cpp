@@ -84,9 +84,14 @@ std::vector<std::string> spec_names(const Specs& specs) {
   return names;
 }
 
-void read_parameters(const config::ConfigNode& node, Parameters& params) {
+void read_parameters(const config::ConfigNode& node, const RigDescription& rig,
+                     Parameters& params) {
   node.expect_keys(spec_names(parameter_specs()));
   for (const auto& spec : parameter_specs()) {
+    if (rig.states_symbol(spec.name) && node.has(spec.name)) {
+      node.at(spec.name).fail(fmt::format(
+          "{} is also stated in the scenario's rig: ({}); give it once", spec.name, rig.source));
+    }
     double& value = parameter(params, spec.name);
     value = node.get_double(spec.name, value, spec.lo, spec.hi);
   }
@@ -225,9 +230,16 @@ std::vector<SupplyChange> read_supply(const config::ConfigNode& node) {
   return changes;
 }
 
-void read_conditions(const config::ConfigNode& node, OperatingConditions& conditions) {
+void read_conditions(const config::ConfigNode& node, const RigDescription& rig,
+                     OperatingConditions& conditions) {
   node.expect_keys({"oil", "temperature", "supply"});
-  if (auto oil = node.find("oil")) conditions.oil = read_oil(*oil);
+  if (auto oil = node.find("oil")) {
+    if (rig.states_symbol("oil")) {
+      oil->fail(fmt::format("the oil is also stated in the scenario's rig: ({}); give it once",
+                            rig.source));
+    }
+    conditions.oil = read_oil(*oil);
+  }
   if (auto temperature = node.find("temperature")) {
     conditions.temperature = read_temperature(*temperature);
   }
@@ -302,8 +314,8 @@ std::vector<SensorFault> read_faults(const config::ConfigNode& node,
 
 Scenario read_scenario(const config::ConfigNode& root) {
   root.expect_keys({"name", "controller", "duration_s", "seed", "sample_rate_hz",
-                    "integration_step_s", "reference", "params", "effects", "sensors", "conditions",
-                    "faults", "record"});
+                    "integration_step_s", "reference", "rig", "params", "effects", "sensors",
+                    "conditions", "faults", "record"});
   Scenario scenario;
   scenario.name = root.get_string("name", "scenario");
   scenario.controller = controller_kind_from_string(
@@ -312,10 +324,17 @@ Scenario read_scenario(const config::ConfigNode& root) {
   scenario.seed = static_cast<std::uint64_t>(root.get_int("seed", 1, 0, (1LL << 62)));
   scenario.sample_rate_hz = root.get_double("sample_rate_hz", 500.0, 50.0, 1e5);
   if (auto node = root.find("reference")) read_reference(*node, scenario.reference);
-  if (auto node = root.find("params")) read_parameters(*node, scenario.params);
+  if (auto node = root.find("rig")) {
+    scenario.rig = read_rig(*node);
+    scenario.params = scenario.rig.params;
+    scenario.conditions.oil = scenario.rig.oil;
+  }
+  if (auto node = root.find("params")) read_parameters(*node, scenario.rig, scenario.params);
   if (auto node = root.find("effects")) read_effects(*node, scenario.effects);
   if (auto node = root.find("sensors")) read_sensors(*node, scenario.sensors);
-  if (auto node = root.find("conditions")) read_conditions(*node, scenario.conditions);
+  if (auto node = root.find("conditions")) {
+    read_conditions(*node, scenario.rig, scenario.conditions);
+  }
   if (auto node = root.find("record")) scenario.record = read_record(*node);
   if (auto node = root.find("faults")) scenario.faults = read_faults(*node, scenario.record);
   if (auto node = root.find("integration_step_s")) {

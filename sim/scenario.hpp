@@ -14,6 +14,7 @@
 #include "sim/parameters.hpp"
 #include "sim/plant.hpp"
 #include "sim/reference.hpp"
+#include "sim/rig_description.hpp"
 #include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
 
@@ -26,6 +27,10 @@ struct Scenario {
   double duration_s = 60.0;
   std::uint64_t seed = 1;
   ReferenceSettings reference;
+  // The rig as described (`rig:`, MODEL.md "Other rigs"); the paper's when the scenario names
+  // none. `params` starts from it; a `params:` override changes the simulated plant only, so
+  // a scenario can run a rig that differs from its description.
+  RigDescription rig;
   Parameters params;
   Effects effects;
   SensorSettings sensors;

@@ -94,6 +94,8 @@ capture::Metadata capture_metadata(const Scenario& scenario) {
   for (const auto& effect : effects) {
     meta.emplace_back("effect", fmt::format("{} {}", effect.name, format_params(effect.params)));
   }
+  // Listed only for another rig, so that the paper's captures read as before.
+  if (!scenario.rig.nominal()) meta.emplace_back("rig", describe(scenario.rig));
   const std::string overrides = overridden_parameters(scenario.params);
   meta.emplace_back("params", overrides.empty() ? "nominal" : overrides);
   const SensorSettings& s = scenario.sensors;
