@@ -335,31 +335,39 @@ std::vector<std::string> fused_keys() {
   return merged(option_keys(index_rows()), option_keys(flow_rows()));
 }
 
+// A kind that is one detector: its options read through its table by Read, then built.
+template <class D, class O, std::vector<Option<O>> (*Rows)(),
+          O (*Read)(const config::ConfigNode*, const AvailableSignals&)>
+DetectorKind single_kind(std::string_view name, std::string_view needs,
+                         bool (*runs_on)(const AvailableSignals&)) {
+  return {name,
+          needs,
+          runs_on,
+          [] { return option_keys(Rows()); },
+          [](const AvailableSignals& s, double hop, const config::ConfigNode* node)
+              -> std::unique_ptr<Detector> { return std::make_unique<D>(Read(node, s), hop); },
+          [] { return options_markdown(Rows()); }};
+}
+
+IndexCusumOptions index_alone(const config::ConfigNode* node, const AvailableSignals& s) {
+  return index_options(node, s, 1.0);
+}
+FlowBalanceOptions flow_alone(const config::ConfigNode* node, const AvailableSignals&) {
+  return flow_options(node, 1.0);
+}
+
 }  // namespace
 
 std::vector<DetectorKind> detector_registry() {
+  constexpr std::string_view kPressure = "a chamber pressure (p1 or p2)", kAll = "p1, p2, u and x";
   return {
-      {"paper", "a chamber pressure (p1 or p2)", has_pressure,
-       [] { return option_keys(paper_rows()); },
-       [](const AvailableSignals& s, double hop,
-          const config::ConfigNode* node) -> std::unique_ptr<Detector> {
-         return std::make_unique<PaperBaselineDetector>(paper_options(node, s), hop);
-       },
-       [] { return options_markdown(paper_rows()); }},
-      {"index_cusum", "a chamber pressure (p1 or p2)", has_pressure,
-       [] { return option_keys(index_rows()); },
-       [](const AvailableSignals& s, double hop,
-          const config::ConfigNode* node) -> std::unique_ptr<Detector> {
-         return std::make_unique<IndexCusumDetector>(index_options(node, s, 1.0), hop);
-       },
-       [] { return options_markdown(index_rows()); }},
-      {"flow_balance", "p1, p2, u and x", has_all, [] { return option_keys(flow_rows()); },
-       [](const AvailableSignals&, double hop,
-          const config::ConfigNode* node) -> std::unique_ptr<Detector> {
-         return std::make_unique<FlowBalanceDetector>(flow_options(node, 1.0), hop);
-       },
-       [] { return options_markdown(flow_rows()); }},
-      {"fused", "p1, p2, u and x", has_all, fused_keys,
+      single_kind<PaperBaselineDetector, PaperBaselineOptions, paper_rows, paper_options>(
+          "paper", kPressure, has_pressure),
+      single_kind<IndexCusumDetector, IndexCusumOptions, index_rows, index_alone>(
+          "index_cusum", kPressure, has_pressure),
+      single_kind<FlowBalanceDetector, FlowBalanceOptions, flow_rows, flow_alone>("flow_balance",
+                                                                                  kAll, has_all),
+      {"fused", kAll, has_all, fused_keys,
        [](const AvailableSignals& s, double hop,
           const config::ConfigNode* node) -> std::unique_ptr<Detector> {
          std::vector<std::unique_ptr<Detector>> members;
@@ -375,13 +383,8 @@ std::vector<DetectorKind> detector_registry() {
              "key both have, such as `block_seconds`, goes to both), and each gets half of "
              "`false_alarms_per_hour`.\n");
        }},
-      {"detail_xcorr", "a chamber pressure (p1 or p2)", has_pressure,
-       [] { return option_keys(xcorr_rows()); },
-       [](const AvailableSignals& s, double hop,
-          const config::ConfigNode* node) -> std::unique_ptr<Detector> {
-         return std::make_unique<DetailXcorrDetector>(xcorr_options(node, s), hop);
-       },
-       [] { return options_markdown(xcorr_rows()); }},
+      single_kind<DetailXcorrDetector, DetailXcorrOptions, xcorr_rows, xcorr_options>(
+          "detail_xcorr", kPressure, has_pressure),
   };
 }
 

@@ -343,6 +343,56 @@ TEST(BlockCusum, TakesBackTheBlocksJudgedAfterAStep) {
   EXPECT_THROW(longer.restore(state, "cusum"), StateError);
 }
 
+// ---- The real-time rule ----
+
+// The pieces on the worker's path allocate nothing once built, through steps and take-backs.
+TEST(SequentialCore, PiecesAllocateNothingAfterConstruction) {
+  DriftReference drift(drift_options(0.05, true));
+  SupplyTracker supply(supply_options(SupplyTrackerOptions::StepRule::drift_from_anchor, 10));
+  BlockCusum cusum(10.0, 60);
+  LearningClock clock(LearningSchedule{}, 0.04);
+  std::mt19937_64 random(5);
+  std::normal_distribution<double> normal;
+  double sink = 0.0;
+  test::AllocationScope scope;
+  for (int i = 0; i < 20000; ++i) {
+    const double t = 0.04 * i;
+    clock.count_hop();
+    const double reading = (t < 400.0 ? 17.2e6 : 15e6) + 1e4 * normal(random);
+    if (supply.add(t, reading, i % 7 == 0)) drift.clear();
+    if (i % 20 == 0) {
+      drift.add(t, 0.01 * normal(random));
+      sink += drift.reference(t, 0.01, false, supply.step_time() + 20.0);
+      cusum.add(t, normal(random));
+      if (i % 2000 == 0) cusum.take_back_after(t - 10.0);
+    }
+  }
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+// index_cusum on one chamber without `ps`: the hold levels find the supply step, the CUSUM
+// takes blocks back, the reference re-anchors; all without an allocation.
+TEST(SequentialCore, OneChamberThroughASupplyStepAllocatesNothing) {
+  auto detector =
+      make_detector("index_cusum", AvailableSignals{true, false, false, false}, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.supply = [](double t) { return t < 200.0 ? 17.2e6 : 15e6; };
+  rig.onset = 300.0;
+  rig.index_drop = 0.3;
+  std::uint64_t allocations = 0;
+  bool raised = false;
+  while (rig.t < 400.0) {
+    const Observation o = rig.next();
+    test::AllocationScope scope;
+    const Decision d = detector->update(o);
+    allocations += scope.count();
+    raised |= d.score >= 1.0;
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(raised) << "the leak after the step was found";
+}
+
 // ---- Every detector's state: named values only ----
 
 // A list longer than one value is a column of records (its siblings under the same prefix
