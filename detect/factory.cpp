@@ -98,8 +98,8 @@ template <class O>
 std::vector<Option<O>> oil_options() {
   return {other_option<O>("oil_grade", "46", "32, 46, 68",
                           "ISO VG grade of the oil (the viscosity ratio with a `temp` channel)",
-                          [](O& o, const OptionSource& source, const Option<O>&) {
-                            if (source.node != nullptr) o.oil = oil_of(*source.node);
+                          [](O& o, const config::ConfigNode* node, const Option<O>&) {
+                            if (node != nullptr) o.oil = oil_of(*node);
                           }),
           other_option<O>("oil_viscosity_40", "-", "1 to 10000",
                           "instead of oil_grade: the data sheet's viscosity at 40 degC [mm^2/s]",
@@ -112,7 +112,7 @@ std::vector<Option<O>> oil_options() {
 template <class O>
 O read_checked(const std::vector<Option<O>>& rows, O options, const config::ConfigNode* node,
                void (*check)(const O&, const config::ConfigNode&)) {
-  read_options(rows, options, OptionSource{node});
+  read_options(rows, options, node);
   if (node != nullptr && check != nullptr) check(options, *node);
   return options;
 }
@@ -135,10 +135,10 @@ std::vector<Option<PaperBaselineOptions>> paper_rows() {
                               "clear threshold on that share (below raise_fraction)",
                               [](O& o) -> double& { return o.clear_fraction; }),
              other_option<O>("channel", "p1 if acquired, else p2", "p1, p2", "the index judged",
-                             [](O& o, const OptionSource& source, const Option<O>& row) {
-                               if (source.node == nullptr) return;
-                               o.use_p2 = source.node->get_choice(row.key, {"p1", "p2"},
-                                                                  o.use_p2 ? "p2" : "p1") == "p2";
+                             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                               if (node == nullptr) return;
+                               o.use_p2 = node->get_choice(row.key, {"p1", "p2"},
+                                                           o.use_p2 ? "p2" : "p1") == "p2";
                              })};
 }
 
@@ -216,10 +216,10 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
              // Always set (also when not configured): the bore is recomputed from the area.
              other_option<O>(
                  "piston_area", "", "", "piston area [m^2]; the default is the rig table's",
-                 [](O& o, const OptionSource& source, const Option<O>& row) {
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
                    double area = o.rig.A();
-                   if (source.node != nullptr) {
-                     area = source.node->get_double(row.key, area, row.lo, row.hi);
+                   if (node != nullptr) {
+                     area = node->get_double(row.key, area, row.lo, row.hi);
                    }
                    set_piston_area(o.rig, area);
                  },
@@ -242,9 +242,9 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
          std::vector<Option<O>>{other_option<O>(
              "estimate_supply", "", "true, false",
              "without `ps`: the supply from the chambers at rest",
-             [](O& o, const OptionSource& source, const Option<O>& row) {
-               if (source.node != nullptr) {
-                 o.estimate_supply = source.node->get_bool(row.key, o.estimate_supply);
+             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+               if (node != nullptr) {
+                 o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
                }
              },
              0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
@@ -272,11 +272,11 @@ std::vector<Option<DetailXcorrOptions>> xcorr_rows() {
                  "design_shift", "", "",
                  "shift of the feature the CUSUM is tuned for: correlation with both chambers, ln "
                  "band ratio with one",
-                 [](O& o, const OptionSource& source, const Option<O>& row) {
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
                    double& design =
                        correlation(o) ? o.design_shift_correlation : o.design_shift_ratio;
-                   if (source.node != nullptr) {
-                     design = source.node->get_double(row.key, design, row.lo, row.hi);
+                   if (node != nullptr) {
+                     design = node->get_double(row.key, design, row.lo, row.hi);
                    }
                  },
                  1e-5, 2.0,
@@ -286,10 +286,10 @@ std::vector<Option<DetailXcorrOptions>> xcorr_rows() {
                  }),
              other_option<O>(
                  "min_shift", "", "", "shift that is never an alarm (below design_shift)",
-                 [](O& o, const OptionSource& source, const Option<O>& row) {
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
                    double& floor = correlation(o) ? o.min_shift_correlation : o.min_shift_ratio;
-                   if (source.node != nullptr) {
-                     floor = source.node->get_double(row.key, floor, row.lo, row.hi);
+                   if (node != nullptr) {
+                     floor = node->get_double(row.key, floor, row.lo, row.hi);
                    }
                  },
                  0.0, 2.0,

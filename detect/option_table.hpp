@@ -17,11 +17,6 @@ namespace leakmon::detect {
 // The longest time option [s].
 inline constexpr double kMaxOptionSeconds = 86400.0;
 
-// What a row reads from: the configured mapping (null: none, all defaults).
-struct OptionSource {
-  const config::ConfigNode* node = nullptr;
-};
-
 template <class O>
 struct Option {
   std::string_view key;
@@ -32,7 +27,7 @@ struct Option {
   // derived value), `read` (null: the key is read by another row), with its default and range
   // stated for the reference (an empty range_text: lo to hi).
   double& (*field)(O&) = nullptr;
-  void (*read)(O&, const OptionSource&, const Option&) = nullptr;
+  void (*read)(O&, const config::ConfigNode*, const Option&) = nullptr;
   std::string_view default_text = {}, range_text = {};
   // The default read from the options (instead of default_text).
   std::string (*default_of)(O&) = nullptr;
@@ -47,8 +42,8 @@ Option<O> number_option(std::string_view key, double lo, double hi, std::string_
 template <class O>
 Option<O> other_option(std::string_view key, std::string_view default_text,
                        std::string_view range_text, std::string_view meaning,
-                       void (*read)(O&, const OptionSource&, const Option<O>&), double lo = 0.0,
-                       double hi = 0.0, std::string (*default_of)(O&) = nullptr) {
+                       void (*read)(O&, const config::ConfigNode*, const Option<O>&),
+                       double lo = 0.0, double hi = 0.0, std::string (*default_of)(O&) = nullptr) {
   return {key, meaning, lo, hi, nullptr, read, default_text, range_text, default_of};
 }
 
@@ -65,15 +60,16 @@ std::vector<std::string> option_keys(const std::vector<Option<O>>& rows) {
   return keys;
 }
 
-// Applies every row in order to `options`: a configured number is range-checked at its key.
+// Applies every row in order to `options` from the configured mapping `node` (null: none, the
+// defaults stay): a configured number is range-checked at its key.
 template <class O>
-void read_options(const std::vector<Option<O>>& rows, O& options, const OptionSource& source) {
+void read_options(const std::vector<Option<O>>& rows, O& options, const config::ConfigNode* node) {
   for (const auto& row : rows) {
     if (row.field != nullptr) {
       double& value = row.field(options);
-      if (source.node != nullptr) value = source.node->get_double(row.key, value, row.lo, row.hi);
+      if (node != nullptr) value = node->get_double(row.key, value, row.lo, row.hi);
     } else if (row.read != nullptr) {
-      row.read(options, source, row);
+      row.read(options, node, row);
     }
   }
 }
