@@ -18,10 +18,10 @@
 #    and AFTER each replay the second part from a copy of that state directory: the state files
 #    of BEFORE must load in AFTER and give the same events. And AFTER -> AFTER must give what
 #    BEFORE -> BEFORE gave (AFTER's own state round trip).
-# 4. `leakmon evaluate` (both builds simulate and replay the same runs): about 2.5 h of healthy,
-#    leak and sensor-fault runs under all drifting conditions (stationary, warmup, cooler,
-#    supply, sensor-faults, restart), every candidate detector on each; every output file must
-#    be byte-identical.
+# 4. `leakmon evaluate` (both builds simulate and replay the same runs): about 3 h of healthy,
+#    leak and sensor-fault runs, healthy and leak runs under each drifting condition (stationary,
+#    warmup, cooler, supply, sensor-faults, restart), every candidate detector on each (so about
+#    3 h per detector); every output file must be byte-identical.
 # --quick: the scenarios and presets only at their own length and fewer evaluate runs.
 # Prints one line per comparison and a summary; exit status 1 when anything differs.
 set -euo pipefail
@@ -200,8 +200,11 @@ for preset in paper-fig10 paper-fig13 paper-fig16; do
 done
 
 echo "## evaluate"
-evaluate=(--healthy-runs 6 --healthy-seconds 900 --runs-per-leak 1 --sensor-fault-runs 6
-  --conditions stationary,warmup,cooler,supply,sensor-faults,restart --seed 26 --jobs 2)
+# Healthy and leak runs cycle through the six conditions (each leak size's runs too); the
+# second six sensor-fault runs have a leak open during the fault.
+evaluate=(--healthy-runs 6 --healthy-seconds 600 --runs-per-leak 6 --leaks 5e-13,2e-12
+  --sensor-fault-runs 12 --conditions stationary,warmup,cooler,supply,sensor-faults,restart
+  --seed 26 --jobs 2)
 [[ $QUICK == 1 ]] && evaluate=(--healthy-runs 2 --healthy-seconds 400 --runs-per-leak 1
   --leaks 1e-12,5e-12 --sensor-fault-runs 2 --conditions warmup,restart --seed 26 --jobs 2)
 for who in before after; do
@@ -213,7 +216,9 @@ done
 for file in evaluate.before/*; do
   compare "evaluate $(basename "$file")" "$file" "evaluate.after/$(basename "$file")"
 done
-echo "evaluate: $(grep -c '"id"' evaluate.before/runs.json) runs, $(sed -nE \
+echo "evaluate: $(grep -c '"id"' evaluate.before/runs.json) runs ($(grep -o '"operating": "[a-z-]*"' \
+  evaluate.before/runs.json | sort | uniq -c | awk '{printf "%s%s %s", (NR > 1 ? ", " : ""), $1, $3}' |
+  tr -d '"')), $(sed -nE \
   's/.*"seconds": ([0-9.e+]+),.*/\1/p' evaluate.before/runs.json |
   awk '{s += $1} END {printf "%.2f h simulated", s / 3600}')"
 
