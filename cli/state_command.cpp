@@ -15,20 +15,10 @@
 #include "daemon/config.hpp"
 #include "daemon/replay.hpp"
 #include "daemon/state_store.hpp"
+#include "detect/legacy_state.hpp"
 
 namespace leakmon::cli {
 namespace {
-
-// Learned when any (member) detector says so: a fitted model or a baseline.
-bool learned(const detect::DetectorState& state) {
-  for (const auto& [key, values] : state.entries()) {
-    const bool model = key == "learned_model" || key.ends_with(".learned_model");
-    const bool baseline = key == "baseline" || key.ends_with(".baseline");
-    if (values.size() == 1 && ((model && values[0] != 0.0) || (baseline && !std::isnan(values[0]))))
-      return true;
-  }
-  return false;
-}
 
 std::string utc(double unix_seconds) {
   const auto t = std::chrono::system_clock::time_point(
@@ -73,7 +63,7 @@ int show(const Target& target) {
   for (const auto& state : listing.states) {
     fmt::print("actuator {}: saved {}, detector {} ({}), alarm {}{}\n", state.actuator,
                utc(state.saved_unix), state.detector.kind(),
-               learned(state.detector) ? "learned" : "still learning",
+               detect::has_learned(state.detector) ? "learned" : "still learning",
                daemon::to_string(state.alarm), state.alarm_condition ? " (condition active)" : "");
     for (const auto& [name, value] : state.fingerprint.parts) {
       fmt::print("  {}: {}\n", name, value);
@@ -147,7 +137,7 @@ int learn(const Target& target, const std::string& capture_path) {
     state.alarm = daemon::AlarmState::normal;
     state.alarm_condition = false;
     store.save(state);
-    const bool done = learned(state.detector);
+    const bool done = detect::has_learned(state.detector);
     fmt::print("actuator {}: {} -> {}\n", state.actuator,
                done ? "learned" : "capture too short, still learning",
                store.file_of(state.actuator).string());

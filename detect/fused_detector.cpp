@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "detect/legacy_state.hpp"
+
 namespace leakmon::detect {
 
 FusedDetector::FusedDetector(std::vector<std::unique_ptr<Detector>> members)
@@ -59,18 +61,13 @@ DetectorState FusedDetector::export_state() const {
   return state;
 }
 
-void FusedDetector::import_state(const DetectorState& state) {
-  reset();
-  try {
-    state.expect(name(), kFusedStateVersion);
-    if (state.get_count("members") != members_.size()) throw StateError("fused: member count");
+void FusedDetector::import_state(const DetectorState& saved) {
+  import_detector_state(*this, saved, kFusedStateVersion, [this](const DetectorState& state) {
+    if (state.get_count("members") != members_.size()) throw StateError("member count");
     for (std::size_t i = 0; i < members_.size(); ++i) {
       members_[i]->import_state(state.get_nested("m" + std::to_string(i)));
     }
-  } catch (...) {
-    reset();
-    throw;
-  }
+  });
 }
 
 }  // namespace leakmon::detect
