@@ -1,4 +1,5 @@
-// A simulation run: controller, duration, seed, reference, parameters, effects, sensors.
+// A simulation run: controller, duration, seed, reference (the paper's steps or a test program),
+// parameters, effects, sensors.
 // Read from YAML (sim/scenarios/*.yaml) through config::ConfigNode, so that unknown keys and
 // out-of-range values fail with file:line:column and the field's path; or built from a preset.
 #pragma once
@@ -13,6 +14,7 @@
 #include "sim/effects.hpp"
 #include "sim/parameters.hpp"
 #include "sim/plant.hpp"
+#include "sim/program.hpp"
 #include "sim/reference.hpp"
 #include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
@@ -25,7 +27,10 @@ struct Scenario {
   ControllerKind controller = ControllerKind::basic;
   double duration_s = 60.0;
   std::uint64_t seed = 1;
-  ReferenceSettings reference;
+  ReferenceSettings reference;  // the paper's steps (the whole run, or a program's steps phases)
+  // The test program (MODEL.md "Test programs"): phases in order, the last to the end of the run.
+  // Empty: the paper's steps from t = 0.
+  std::vector<Phase> program;
   Parameters params;
   Effects effects;
   SensorSettings sensors;
