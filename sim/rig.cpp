@@ -5,7 +5,8 @@ namespace leakmon::sim {
 Rig::Rig(const Scenario& scenario)
     : scenario_(scenario),
       period_(1.0 / scenario.sample_rate_hz),
-      reference_(scenario.reference, stream_seed(scenario.seed, RandomStream::reference)),
+      reference_(scenario.program, scenario.reference,
+                 stream_seed(scenario.seed, RandomStream::reference), scenario.duration_s),
       controller_(scenario.controller, scenario.sample_rate_hz, scenario.params.u_max),
       plant_(scenario.params, scenario.effects,
              stream_seed(scenario.seed, RandomStream::flow_noise), integration_step(scenario)),

@@ -8,7 +8,7 @@
 
 #include "sim/controller.hpp"
 #include "sim/plant.hpp"
-#include "sim/reference.hpp"
+#include "sim/program.hpp"
 #include "sim/scenario.hpp"
 #include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
@@ -17,7 +17,7 @@ namespace leakmon::sim {
 
 struct RigSample {
   double t;          // s
-  double xref;       // m
+  double xref;       // m (the program's reference, before the controller's prefilter)
   double u;          // V, as commanded (before valve_bias)
   double x, p1, p2;  // recorded (sensor chain and any sensor fault applied)
   double ps, temp;   // recorded supply pressure [Pa] and oil temperature [degC]
@@ -45,7 +45,7 @@ class Rig {
  private:
   Scenario scenario_;
   double period_;
-  Reference reference_;
+  ProgramReference reference_;
   Controller controller_;
   Plant plant_;
   Sensors sensors_;

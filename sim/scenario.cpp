@@ -27,9 +27,10 @@ struct EffectSpec {
 
 const std::vector<EffectSpec>& effect_specs() {
   static const std::vector<EffectSpec> specs = {
-      {"internal_leakage", {{"C_L", 0.0, 1e-9}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
+      // ramp_s: from a needle valve opened by hand (a second) to a seal that wears (hours).
+      {"internal_leakage", {{"C_L", 0.0, 1e-9}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e6}}},
       {"external_leakage",
-       {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
+       {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e6}}},
       {"coulomb_friction", {{"F_C", 0.0, 1e4}}},
       {"entrained_air", {{"alpha", 0.0, 1.0}}},
       {"valve_overlap", {{"d", 0.0, 0.5}}},
@@ -134,6 +135,71 @@ void read_reference(const config::ConfigNode& node, ReferenceSettings& reference
   reference.hold_max = node.get_double("hold_max", reference.hold_max, 1e-3, 1e5);
   if (reference.amp_max < reference.amp_min) node.fail("amp_max must not be below amp_min");
   if (reference.hold_max < reference.hold_min) node.fail("hold_max must not be below hold_min");
+}
+
+// MODEL.md "Test programs": `- {phase: sine, F: 0.5, A: 0.02, duration_s: 240}`, the values
+// named by MODEL.md's symbols; every phase but the last needs its length.
+std::vector<Phase> read_program(const config::ConfigNode& node, const Parameters& params) {
+  if (!node.is_sequence() || node.items().empty()) {
+    node.fail(
+        "must be a list of phases {phase: steps|hold|sine|sweep|triangle, their values, "
+        "duration_s}");
+  }
+  const double half_stroke = 0.5 * params.L;
+  const auto inside_stroke = [&](const config::ConfigNode& item, std::string_view key,
+                                 double value) {
+    if (std::abs(value) >= half_stroke) {
+      item.at(key).fail(fmt::format("{} must stay inside the stroke (|{}| < L/2 = {:g} m)", key,
+                                    key, half_stroke));
+    }
+  };
+  std::vector<Phase> program;
+  const auto items = node.items();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const config::ConfigNode& item = items[i];
+    if (!item.is_map()) item.fail("a phase is a mapping {phase: KIND, its values, duration_s}");
+    if (!item.has("phase")) item.fail("phase is required (steps, hold, sine, sweep or triangle)");
+    Phase phase;
+    phase.kind = *phase_kind_from_string(
+        item.get_choice("phase", {"steps", "hold", "sine", "sweep", "triangle"}, "steps"));
+    switch (phase.kind) {
+      case PhaseKind::steps:
+        item.expect_keys({"phase", "duration_s"});
+        break;
+      case PhaseKind::hold:
+        item.expect_keys({"phase", "X", "duration_s"});
+        phase.X = item.get_double("X", -10.0, 10.0);
+        inside_stroke(item, "X", phase.X);
+        break;
+      case PhaseKind::sine:
+        item.expect_keys({"phase", "F", "A", "duration_s"});
+        phase.F = item.get_double("F", 1e-4, 100.0);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+      case PhaseKind::sweep:
+        item.expect_keys({"phase", "F0", "F1", "A", "duration_s"});
+        phase.F0 = item.get_double("F0", 0.0, 100.0);
+        phase.F1 = item.get_double("F1", 0.0, 100.0);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+      case PhaseKind::triangle:
+        item.expect_keys({"phase", "P", "A", "duration_s"});
+        phase.P = item.get_double("P", 1e-3, 1e5);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+    }
+    if (phase.kind != PhaseKind::steps && phase.kind != PhaseKind::hold) {
+      inside_stroke(item, "A", phase.A);
+    }
+    const bool last = i + 1 == items.size();
+    if (!last && !item.has("duration_s")) {
+      item.fail("duration_s is required for every phase but the last (which runs to the end)");
+    }
+    // A sweep needs its T; the last phase's defaults to the rest of the run.
+    phase.duration_s = item.has("duration_s") ? item.get_double("duration_s", 0.002, 1e7) : 0.0;
+    program.push_back(phase);
+  }
+  return program;
 }
 
 void read_sensors(const config::ConfigNode& node, SensorSettings& sensors) {
@@ -314,8 +380,8 @@ std::vector<SensorFault> read_faults(const config::ConfigNode& node,
 
 Scenario read_scenario(const config::ConfigNode& root) {
   root.expect_keys({"name", "controller", "duration_s", "seed", "sample_rate_hz",
-                    "integration_step_s", "reference", "rig", "params", "effects", "sensors",
-                    "conditions", "faults", "record"});
+                    "integration_step_s", "reference", "program", "rig", "params", "effects",
+                    "sensors", "conditions", "faults", "record"});
   Scenario scenario;
   scenario.name = root.get_string("name", "scenario");
   scenario.controller = controller_kind_from_string(
@@ -330,6 +396,7 @@ Scenario read_scenario(const config::ConfigNode& root) {
     scenario.conditions.oil = scenario.rig.oil;
   }
   if (auto node = root.find("params")) read_parameters(*node, scenario.rig, scenario.params);
+  if (auto node = root.find("program")) scenario.program = read_program(*node, scenario.params);
   if (auto node = root.find("effects")) read_effects(*node, scenario.effects);
   if (auto node = root.find("sensors")) read_sensors(*node, scenario.sensors);
   if (auto node = root.find("conditions")) {

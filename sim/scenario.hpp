@@ -1,4 +1,5 @@
-// A simulation run: controller, duration, seed, reference, parameters, effects, sensors.
+// A simulation run: controller, duration, seed, reference (the paper's steps or a test program),
+// parameters, effects, sensors.
 // Read from YAML (sim/scenarios/*.yaml) through config::ConfigNode, so that unknown keys and
 // out-of-range values fail with file:line:column and the field's path; or built from a preset.
 #pragma once
@@ -13,6 +14,7 @@
 #include "sim/effects.hpp"
 #include "sim/parameters.hpp"
 #include "sim/plant.hpp"
+#include "sim/program.hpp"
 #include "sim/reference.hpp"
 #include "sim/rig_description.hpp"
 #include "sim/sensor_faults.hpp"
@@ -26,7 +28,10 @@ struct Scenario {
   ControllerKind controller = ControllerKind::basic;
   double duration_s = 60.0;
   std::uint64_t seed = 1;
-  ReferenceSettings reference;
+  ReferenceSettings reference;  // the paper's steps (the whole run, or a program's steps phases)
+  // The test program (MODEL.md "Test programs"): phases in order, the last to the end of the run.
+  // Empty: the paper's steps from t = 0.
+  std::vector<Phase> program;
   // The rig as described (`rig:`, MODEL.md "Other rigs"); the paper's when the scenario names
   // none. `params` starts from it; a `params:` override changes the simulated plant only, so
   // a scenario can run a rig that differs from its description.

@@ -75,6 +75,23 @@ std::string overridden_parameters(const Parameters& p) {
   return out;
 }
 
+// "hold 0.02 for 180 s; steps for 300 s; ...; triangle 4 0.03 to the end".
+std::string program_description(const std::vector<Phase>& program) {
+  std::string out;
+  for (std::size_t i = 0; i < program.size(); ++i) {
+    if (i > 0) out += "; ";
+    out += program[i].notation();
+    if (i + 1 < program.size()) {
+      out += fmt::format(" for {:.10g} s", program[i].duration_s);
+    } else if (program[i].duration_s > 0.0) {
+      out += fmt::format(" (T {:.10g} s) to the end", program[i].duration_s);
+    } else {
+      out += " to the end";
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 capture::Metadata capture_metadata(const Scenario& scenario) {
@@ -109,8 +126,18 @@ capture::Metadata capture_metadata(const Scenario& scenario) {
                         s.position_resolution, s.position_quantisation ? "" : " (unquantised)",
                         s.position_noise_sigma)
           : std::string("ideal (true values)"));
-  // Drifting conditions, faults and optional transducers: listed only when present, so that a
-  // stationary scenario's metadata reads as before.
+  // A test program, drifting conditions, faults and optional transducers: listed only when
+  // present, so that a stationary scenario on the paper's steps reads as before.
+  if (!scenario.program.empty()) {
+    meta.emplace_back("program", program_description(scenario.program));
+    // One line per phase with where it sits in this run, for scoring per phase.
+    const auto spans = phase_spans(scenario.program, scenario.duration_s);
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+      meta.emplace_back(
+          "phase", fmt::format("{} start_s={:.10g} end_s={:.10g}", scenario.program[i].notation(),
+                               spans[i].start, spans[i].end));
+    }
+  }
   const OperatingConditions& c = scenario.conditions;
   if (c.temperature) {
     meta.emplace_back("oil", fmt::format("{}nu40={:g} nu100={:g} (Walther, ASTM D341)",
