@@ -35,6 +35,14 @@ def run(*command, **kwargs):
     return subprocess.run(list(map(str, command)), capture_output=True, text=True, **kwargs)
 
 
+prefix = re.search(r"^CMAKE_INSTALL_PREFIX:PATH=(.*)$",
+                   (BUILD / "CMakeCache.txt").read_text(), re.M).group(1)
+if prefix != "/usr":
+    # A build tree configured before the default prefix became /usr keeps its cached one.
+    print(f"FAIL this build tree installs under {prefix}, the package's paths are /usr and /etc: "
+          f"configure a fresh build directory (the default prefix is /usr) or pass "
+          f"-DCMAKE_INSTALL_PREFIX=/usr")
+    sys.exit(1)
 shutil.rmtree(SCRATCH, ignore_errors=True)
 SCRATCH.mkdir(parents=True)
 packed = run("cpack", "-G", "DEB", "--config", BUILD / "CPackConfig.cmake", "-B", SCRATCH)
