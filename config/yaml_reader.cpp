@@ -237,8 +237,8 @@ std::vector<std::size_t> content_columns(std::string_view line) {
 // an operator needs the mistake (indentation, tabs, an unclosed bracket, an unquoted colon).
 std::string syntax_hint(const std::string& text, const YAML::Exception& e) {
   const auto lines = split_lines(text);
-  const std::size_t line_index =
-      e.mark.is_null() ? lines.size() : static_cast<std::size_t>(e.mark.line);
+  const bool located = !e.mark.is_null() && e.mark.line >= 0;
+  const std::size_t line_index = located ? static_cast<std::size_t>(e.mark.line) : lines.size();
   for (std::size_t i = 0; i <= line_index && i < lines.size(); ++i) {
     const std::string_view line = lines[i];
     const std::size_t first = line.find_first_not_of(" \t");
@@ -247,7 +247,7 @@ std::string syntax_hint(const std::string& text, const YAML::Exception& e) {
       return fmt::format("line {} is indented with a tab: YAML indents with spaces only", i + 1);
     }
   }
-  if (e.mark.is_null() || line_index >= lines.size()) return "";
+  if (!located || line_index >= lines.size()) return "";
   const std::string_view here = lines[line_index];
   // The columns the content above begins at, nearest line first: where this line could belong.
   std::vector<std::size_t> above;
