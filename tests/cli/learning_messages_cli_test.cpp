@@ -94,15 +94,16 @@ TEST(LearningMessages, RunLogsTheDetectorAndTheEndOfLearning) {
                            "learn_seconds: 2}}\n"
                            "state: {directory: ''}\n"
                            "metrics: {port: 0}\n";
-  const Invocation daemon = run("run --config " + config + " --duration 8");
+  // Real time: on a loaded machine missed cycles make gaps, which delay the end of learning.
+  const Invocation daemon = run("run --config " + config + " --duration 12");
   ASSERT_EQ(daemon.status, 0) << daemon.output;
   EXPECT_NE(daemon.output.find("cylinder: detector flow_balance (default for p1, p2, u, x); "
                                "learns the healthy rig during its first 3.8 s of data"),
             std::string::npos)
       << daemon.output;
+  // Not before the planned 3.8 s of data (to the hop); later when cycles were missed.
   const double ended = number_after(daemon.output, "cylinder: learned the healthy rig until t = ");
-  EXPECT_GE(ended, 3.5) << daemon.output;
-  EXPECT_LE(ended, 6.0) << daemon.output;
+  EXPECT_GE(ended, 3.7) << daemon.output;
 }
 
 }  // namespace
