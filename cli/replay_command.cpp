@@ -9,6 +9,7 @@
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
 #include "daemon/event_log.hpp"
+#include "daemon/learning_report.hpp"
 #include "daemon/replay.hpp"
 
 namespace leakmon::cli {
@@ -49,6 +50,17 @@ int run_replay(int argc, char** argv) {
   if (!out) throw std::runtime_error(fmt::format("{}: write failed", args.get("events")));
   fmt::print(stderr, "{}: {} samples, {} events -> {}\n", args.get("in"), result.samples_processed,
              result.events.size(), args.get("events"));
+  // Which detector ran and when it stopped learning: a leak the capture opens while the
+  // detector still learns is learned as healthy, and the events alone would not say so.
+  for (const auto& status : result.actuators) {
+    for (const auto& actuator : config.actuators) {
+      if (actuator.name != status.name) continue;
+      fmt::print(stderr, "{}\n", daemon::detector_line(actuator, status));
+      if (const auto line = daemon::learning_line(status); !line.empty()) {
+        fmt::print(stderr, "{}\n", line);
+      }
+    }
+  }
   return 0;
 }
 

@@ -343,7 +343,9 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
     ++suspended_decisions_;
     return;
   }
+  const bool was_learning = last_decision_.learning;
   last_decision_ = detector_->update(observation);
+  if (was_learning && !last_decision_.learning) learning_ended_t_ = t;
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
   if (watch_mode_) judge_mode_visibility(t, observation, publish);
@@ -434,6 +436,8 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.detector = detector_->name();
   status.state = alarm_.state();
   status.learning = last_decision_.learning;
+  status.learning_seconds = learning_seconds();
+  status.learning_ended_t = learning_ended_t_;
   status.raise_threshold = alarm_.settings().raise_threshold;
   status.clear_threshold = alarm_.settings().clear_threshold;
   status.t = last_t_;

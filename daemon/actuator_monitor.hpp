@@ -53,6 +53,11 @@ struct ActuatorStatus {
   bool learning = true;
   // Source seconds until the detector decides: 0 once it does, NaN before the first sample.
   double learning_seconds_left = io::kNoValue;
+  // How long learning takes from the first sample (the features' first window and the
+  // detector's settling and learning), and the source time it ended (NaN: not yet, or resumed
+  // from a learned state).
+  double learning_seconds = io::kNoValue;
+  double learning_ended_t = io::kNoValue;
   double raise_threshold = io::kNoValue;  // the score at which the alarm raises
   double clear_threshold = io::kNoValue;
   double t = io::kNoValue;         // source time of the newest decision
@@ -213,6 +218,7 @@ class ActuatorMonitor {
   double newest_t_ = io::kNoValue;
   double protected_from_ = io::kNoValue;  // source time of the first decision (expected)
   std::uint64_t relearns_ = 0;
+  double learning_ended_t_ = io::kNoValue;
 };
 
 }  // namespace leakmon::daemon

@@ -1,15 +1,19 @@
 #include "daemon/config.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <net/if.h>
+#include <netdb.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -17,10 +21,13 @@
 #include <set>
 #include <stdexcept>
 
+#include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
 #include "daemon/output_registry.hpp"
 #include "daemon/sample.hpp"
 #include "detect/factory.hpp"
+#include "io/modbus/modbus_config.hpp"
+#include "io/modbus/modbus_link.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -90,6 +97,41 @@ dsp::FeatureParams parse_features(const config::ConfigNode& node) {
     node.fail(e.what());
   }
   return params;
+}
+
+// Leak sizes as a rig engineer reads them: `min_leak: 0.03 l/min/MPa` (the detectors' options
+// are in m^3/(s Pa)). The value is rewritten in place as its SI number, so the detector reads it
+// as before and its range errors still point at the field.
+void convert_leak_sizes(const config::ConfigNode& options) {
+  if (!options.is_map()) return;
+  constexpr std::string_view kUnit = "l/min/MPa";
+  for (const auto& [key, value] : options.entries()) {
+    if (!value.is_scalar()) continue;
+    const std::string text = value.as_string();
+    const auto unit = text.find(kUnit);
+    if (unit == std::string::npos) continue;
+    if (key != "design_leak" && key != "min_leak") {
+      value.fail(
+          fmt::format("{} is not a leak size (l/min/MPa applies to design_leak and "
+                      "min_leak)",
+                      key));
+    }
+    std::string number = text.substr(0, unit);
+    while (!number.empty() && number.back() == ' ') number.pop_back();
+    const bool unit_last = text.find_first_not_of(' ', unit + kUnit.size()) == std::string::npos;
+    double lpm_per_mpa = 0.0;
+    const auto [end, error] =
+        std::from_chars(number.data(), number.data() + number.size(), lpm_per_mpa);
+    if (number.empty() || error != std::errc() || end != number.data() + number.size() ||
+        !unit_last || !std::isfinite(lpm_per_mpa)) {
+      value.fail(
+          fmt::format("expected a number followed by l/min/MPa (e.g. 0.03 l/min/MPa), got "
+                      "'{}'",
+                      text));
+    }
+    YAML::Node scalar = value.yaml();  // shares the document's node: the detector sees SI
+    scalar = fmt::format("{:.17g}", units::cubic_metres_per_second_pascal(lpm_per_mpa));
+  }
 }
 
 AlarmSettings parse_alarm(const config::ConfigNode& node) {
@@ -174,6 +216,7 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
       detector->expect_keys({"kind", "options"});
       actuator.detector = detector->get_string("kind", "default");
       actuator.detector_options = detector->find("options");
+      if (actuator.detector_options) convert_leak_sizes(*actuator.detector_options);
     }
     const auto kinds = detect::detector_kinds();
     if (std::find(kinds.begin(), kinds.end(), actuator.detector) == kinds.end()) {
@@ -557,6 +600,91 @@ void check_devices(const DaemonConfig& config) {
   }
 }
 
+namespace {
+
+// Connects to host:port within `timeout_ms`; empty on success, else why not.
+std::string tcp_connect_problem(const std::string& host, int port, int timeout_ms) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  if (const int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0) {
+    return fmt::format("cannot resolve '{}': {}", host, ::gai_strerror(rc));
+  }
+  std::string problem = "no address";
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    const int fd =
+        ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
+    if (fd < 0) {
+      problem = std::strerror(errno);
+      continue;
+    }
+    int error = ::connect(fd, a->ai_addr, a->ai_addrlen) == 0 ? 0 : errno;
+    if (error == EINPROGRESS) {
+      pollfd waiting{fd, POLLOUT, 0};
+      const int ready = ::poll(&waiting, 1, timeout_ms);
+      socklen_t length = sizeof(error);
+      if (ready == 1) {
+        ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &length);
+      } else {
+        error = ETIMEDOUT;
+      }
+    }
+    ::close(fd);
+    if (error == 0) {
+      ::freeaddrinfo(found);
+      return "";
+    }
+    problem = error == ETIMEDOUT ? fmt::format("no answer within {} ms", timeout_ms)
+                                 : std::string(std::strerror(error));
+  }
+  ::freeaddrinfo(found);
+  return problem;
+}
+
+// `check-config`'s network check of a peer written at `node` (a driver or output mapping):
+// `problem` is why it does not answer, empty when it does.
+void check_peer(const config::ConfigNode& node, const std::string& host, int port,
+                std::string_view what, const std::string& problem) {
+  if (problem.empty()) return;
+  const auto where = node.find("host");
+  (where ? *where : node)
+      .fail(fmt::format("{} {}:{} does not answer: {} (is it on, and is this the right "
+                        "address? --no-peers leaves this check out)",
+                        what, host, port, problem));
+}
+
+}  // namespace
+
+void check_peers(const DaemonConfig& config) {
+  constexpr int kConnectTimeoutMs = 3000;
+  // A Modbus device must answer a read (a TCP connection alone can be a gateway's, or a
+  // firewall's that accepts everything); the alarm output and the broker must accept one.
+  for (const auto& driver : config.drivers) {
+    if (!driver.node || driver.type != "modbus") continue;
+    const auto modbus = io::modbus::parse_modbus_config(*driver.node);
+    if (!modbus.tcp) continue;
+    check_peer(*driver.node, modbus.tcp->host, modbus.tcp->port, "Modbus device",
+               io::modbus::unanswered(modbus));
+  }
+  for (const auto& node : config.outputs) {
+    const std::string type = node.get_string("type");
+    if (type == "modbus" && node.get_string("transport", "tcp") == "tcp") {
+      const std::string host = node.get_string("host");
+      const int port = static_cast<int>(node.get_int("port", 502, 1, 65535));
+      check_peer(node, host, port, "Modbus alarm output",
+                 tcp_connect_problem(host, port, kConnectTimeoutMs));
+    } else if (type == "mqtt") {
+      const std::string host = node.get_string("host", "127.0.0.1");
+      const int port =
+          static_cast<int>(node.get_int("port", node.has("tls") ? 8883 : 1883, 1, 65535));
+      check_peer(node, host, port, "MQTT broker",
+                 tcp_connect_problem(host, port, kConnectTimeoutMs));
+    }
+  }
+}
+
 DaemonConfig check_config(const std::string& path, const Preflight& preflight) {
   DaemonConfig config = load_config(path);
   check_paths(config);
@@ -570,6 +698,13 @@ DaemonConfig check_config(const std::string& path, const Preflight& preflight) {
   }
   check_channels(config, driver_channels);
   for (const auto& node : config.outputs) make_output(node);
+  for (const auto& driver : config.drivers) {
+    if (driver.type != "modbus" || !driver.node) continue;
+    const auto modbus = io::modbus::parse_modbus_config(*driver.node);
+    config.warnings.insert(config.warnings.end(), modbus.warnings.begin(), modbus.warnings.end());
+  }
+  // Last: the peers are only worth asking once everything else in the file is right.
+  if (preflight.peers) check_peers(config);
   return config;
 }
 

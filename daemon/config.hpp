@@ -96,6 +96,9 @@ struct DaemonConfig {
   std::vector<ActuatorConfig> actuators;
   std::string event_log;  // JSON-lines file; empty: none
   std::optional<config::ConfigNode> event_log_where;
+  // Legal but probably wrong (two Modbus channels on the same registers), each
+  // `file:line:column: message`; filled by check_config(), printed by check-config, logged by run.
+  std::vector<std::string> warnings;
   RecordingConfig recording;
   StateConfig state{config::default_state_directory(), 60.0, std::nullopt};
   MetricsConfig metrics;
@@ -124,6 +127,9 @@ struct Preflight {
   // The metrics address and port can be bound now (nothing else listens there). A running
   // daemon's reload leaves this out: it holds the port itself.
   bool port = true;
+  // Network peers (Modbus TCP devices, MQTT brokers) accept a TCP connection now. Only
+  // `leakmon check-config`: the daemon starts without them and reconnects when they come.
+  bool peers = false;
 };
 
 // Full validation, the one `leakmon check-config` and `leakmon run` (and SIGHUP) share, so that
@@ -137,6 +143,7 @@ DaemonConfig check_config(const std::string& path, const Preflight& preflight = 
 void check_paths(const DaemonConfig& config);
 void check_port(const DaemonConfig& config);
 void check_devices(const DaemonConfig& config);
+void check_peers(const DaemonConfig& config);
 
 // Checks actuator channel references and group sizes against the channels the built drivers
 // offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.

@@ -15,6 +15,7 @@
 #include "daemon/driver_registry.hpp"
 #include "daemon/event_log.hpp"
 #include "daemon/http_router.hpp"
+#include "daemon/learning_report.hpp"
 #include "daemon/output_registry.hpp"
 
 namespace leakmon::daemon {
@@ -186,6 +187,15 @@ void Daemon::start() {
                  config_.state.directory, config_.state.save_seconds);
   }
 
+  for (const auto& warning : config_.warnings) spdlog::warn("{}", warning);
+  // Which detector runs for each actuator, and how long it learns before it can raise alarms.
+  for (const auto& status : worker_->status()) {
+    for (const auto& actuator : config_.actuators) {
+      if (actuator.name == status.name) spdlog::info("{}", detector_line(actuator, status));
+    }
+    learning_[status.name] = status.learning;
+  }
+
   {
     io::Event event;
     event.kind = io::EventKind::daemon_started;
@@ -355,6 +365,12 @@ void Daemon::housekeeping(std::int64_t now_ns) {
     save_state(with_trend);
     last_state_save_ns_ = now_ns;
     if (with_trend) last_trend_save_ns_ = now_ns;
+  }
+  // The end of each actuator's learning, once (a reload that relearns starts it again).
+  for (const auto& status : worker_->status()) {
+    bool& learning = learning_[status.name];
+    if (learning && !status.learning) spdlog::info("{}", learning_line(status));
+    learning = status.learning;
   }
   // Overruns: at most one warning (and one event) per second for all groups.
   if (now_ns - last_overrun_warning_ns_ >= kSecond) {

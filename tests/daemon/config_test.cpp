@@ -182,6 +182,40 @@ constexpr const char* kBase =
     "actuators: [{name: a, channels: {p1: p1}}]\n"
     "state: {directory: ''}\n";
 
+// Issue 25: leak sizes in the unit a rig engineer reads (l/min/MPa), where the configuration
+// takes one; the detector still receives m^3/(s Pa), and mistakes name file:line:column.
+TEST(DaemonConfig, LeakSizesMayBeGivenInLitresPerMinutePerMegapascal) {
+  const std::string actuator =
+      "actuators:\n"
+      "  - name: a\n"
+      "    channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x}\n"
+      "    detector:\n"
+      "      kind: flow_balance\n"
+      "      options:\n";
+  const auto config =
+      parse_config(config::ConfigNode::load_string(std::string(kDriver) + actuator +
+                                                       "        min_leak: 0.03 l/min/MPa\n"
+                                                       "        design_leak: 0.015l/min/MPa\n"
+                                                       "        learn_seconds: 30\n",
+                                                   "rig.yaml"));
+  const auto& options = *config.actuators.at(0).detector_options;
+  EXPECT_NEAR(options.at("min_leak").as_double(), 5e-13, 1e-27);
+  EXPECT_NEAR(options.at("design_leak").as_double(), 2.5e-13, 1e-27);
+  EXPECT_EQ(options.at("learn_seconds").as_double(), 30.0);
+  // The detector is built from them, as check-config does.
+  std::vector<std::vector<std::string>> channels{{"p1", "p2", "u", "x"}};
+  EXPECT_NO_THROW(check_channels(config, channels));
+  EXPECT_EQ(error_of(std::string(kDriver) + actuator + "        learn_seconds: 3 l/min/MPa\n"),
+            "rig.yaml:8:24: actuators[0].detector.options.learn_seconds: learn_seconds is not a "
+            "leak size (l/min/MPa applies to design_leak and min_leak)");
+  EXPECT_EQ(error_of(std::string(kDriver) + actuator + "        min_leak: lots l/min/MPa\n"),
+            "rig.yaml:8:19: actuators[0].detector.options.min_leak: expected a number followed "
+            "by l/min/MPa (e.g. 0.03 l/min/MPa), got 'lots l/min/MPa'");
+  EXPECT_NE(error_of(std::string(kDriver) + actuator + "        min_leak: 0.03 l/min/MPa/s\n")
+                .find("expected a number followed by l/min/MPa"),
+            std::string::npos);
+}
+
 TEST(DaemonConfig, MetricsAddressMustBeAnIpv4Address) {
   const std::string dir = test::scratch_dir("config_preflight_address");
   for (const char* address : {"256.1.1.1", "localhost", "1.2.3", "::1"}) {
