@@ -23,6 +23,7 @@ int run_check_config(int argc, char** argv) {
   if (args.flag_set("no-probe")) preflight = daemon::Preflight{false, false};
   try {
     const auto config = daemon::check_config(path, preflight);
+    for (const auto& warning : config.warnings) fmt::print(stderr, "warning: {}\n", warning);
     fmt::print("{}: ok ({} driver(s), {} sampling group(s), {} actuator(s){})\n", path,
                config.drivers.size(), config.groups.size(), config.actuators.size(),
                preflight.devices ? "" : "; devices and port not probed");

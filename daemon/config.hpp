@@ -14,6 +14,7 @@
 #include "daemon/alarm.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::daemon {
 
@@ -50,11 +51,17 @@ struct ActuatorConfig {
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;
+  // The rig's description (`rig:`, FORMATS.md): the base of the detector's supply, tank pressure,
+  // valve, piston area, command full scale and oil, which detector options of the same values
+  // override (detect/rig_options.hpp); the paper's rig when absent. A stated supply also sets
+  // the pressure transducers' default range (sim::standard_pressure_full_scale).
+  sim::RigDescription rig;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   std::string alarm_name = "internal_leakage";
   // The transducers behind p1, p2 and x, for their plausibility checks (`transducers:`);
-  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise.
+  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise
+  // (pressures 12 bit over the rig's standard range when `rig:` states the supply).
   detect::TransducerSpec p1_transducer = detect::TransducerSpec::pressure();
   detect::TransducerSpec p2_transducer = detect::TransducerSpec::pressure();
   detect::TransducerSpec x_transducer = detect::TransducerSpec::position();
@@ -103,6 +110,10 @@ struct DaemonConfig {
   // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency
   // (target p99 < 1 ms) at the cost of 2000 cheap wake-ups a second.
   std::int64_t worker_poll_ns = 500'000;
+  // What is valid but probably not meant (e.g. a value given both in `rig:` and in the
+  // detector's options), "file:line:column: message"; check-config prints them, the daemon logs
+  // them at start.
+  std::vector<std::string> warnings;
   // SCHED_FIFO priority of the worker thread (below the loops'), so that decisions and alarm
   // events keep their latency on a loaded machine; 0 keeps normal scheduling.
   int worker_priority = 70;
@@ -142,6 +153,12 @@ void check_devices(const DaemonConfig& config);
 // offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.
 void check_channels(const DaemonConfig& config,
                     const std::vector<std::vector<std::string>>& driver_channels);
+
+// Sets the actuator's rig and what follows from it where nothing else is configured: the
+// pressure transducers' range (12 bit over sim::standard_pressure_full_scale of a stated
+// supply). `parse_config` calls it before it reads `transducers:`; `leakmon replay --rig` on the
+// built-in defaults.
+void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig);
 
 // The group that holds `driver`, or nullptr.
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);

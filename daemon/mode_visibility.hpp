@@ -22,12 +22,20 @@
 //   - seal friction 50-400 N: 1.6-2.1;
 //   - a soft rig (beta -25 %, b +30 %) with free air alpha 0.2: 2.0.
 // On the last two, a 5e-12 leak went unseen by every pressure-only detector.
+//
+// On another rig the mode itself moves (MODEL.md "Other rigs": with m, A, beta and the volumes).
+// Far out of the band the index falls to the noise floor and the ratio says so; near the band's
+// edges it does not: a 50 mm bore with 80 kg (mode 44.5 Hz) kept the ratio above 2.5 while a
+// 3e-12 leak was found in 1 of 3 runs by either pressure-only detector (docs/detection.md, "Other
+// rigs"). So where the actuator's `rig:` describes the rig, its mode frequency at mid-stroke
+// decides too: outside readable_band() the rig is blind whatever the ratio.
 #pragma once
 
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <numbers>
 
 namespace leakmon::daemon {
 
@@ -42,6 +50,27 @@ class ModeVisibilityCheck {
   // level-2 details of an orthonormal wavelet keep white noise's variance.
   static double noise_floor_pa(double sigma, double resolution) noexcept {
     return std::sqrt(sigma * sigma + resolution * resolution / 12.0);
+  }
+
+  // The hydraulic mode at mid-stroke [Hz]: the two oil columns (V1 = V2 = V0) against the moving
+  // mass, sqrt(beta A^2 (1/V1 + 1/V2) / m) / (2 pi); 73.5 Hz on MODEL.md's nominal rig.
+  static double mode_frequency_hz(double bulk_modulus, double area, double chamber_volume,
+                                  double mass) noexcept {
+    return std::sqrt(2.0 * bulk_modulus * area * area / (chamber_volume * mass)) /
+           (2.0 * std::numbers::pi);
+  }
+
+  // Where a mode still shows in the details of `level`: their band fs/2^(level+1)..fs/2^level
+  // widened to where db8's equivalent filter is 12 dB below its passband (0.74 x the lower and
+  // 1.22 x the upper edge: 46.5 and 153 Hz at level 2 and 500 Hz). Measured on simulated rigs
+  // with a 3e-12 leak (docs/detection.md, "Other rigs"): modes of 48-145 Hz were found by both
+  // pressure-only detectors in every run, 44.5 Hz in 1 of 3, 42 Hz and below in none.
+  struct Band {
+    double low, high;
+  };
+  static Band readable_band(double sample_rate_hz, int level) noexcept {
+    const double upper_edge = sample_rate_hz / std::exp2(level);
+    return {0.74 * upper_edge / 2.0, 1.22 * upper_edge};
   }
 
   // One learning hop's index [Pa]; NaN (a gap, an unacquired chamber) is not counted.

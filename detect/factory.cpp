@@ -94,9 +94,9 @@ void expect_keys(const config::ConfigNode* options, std::initializer_list<KeyLis
 }
 
 // The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
-// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; VG 46 when
-// neither is given.
-sim::Oil oil_of(const config::ConfigNode& options) {
+// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; the rig's oil
+// (VG 46 unless its description says otherwise) when neither is given.
+sim::Oil oil_of(const config::ConfigNode& options, const sim::Oil& rig_oil) {
   const auto grade = options.find("oil_grade");
   const auto nu40 = options.find("oil_viscosity_40");
   const auto nu100 = options.find("oil_viscosity_100");
@@ -115,12 +115,14 @@ sim::Oil oil_of(const config::ConfigNode& options) {
     if (!(a > b)) nu100->fail("oil_viscosity_100 must be below oil_viscosity_40");
     return sim::Oil(a, b);
   }
-  return sim::Oil::standard();
+  return rig_oil;
 }
 
 IndexCusumOptions index_options(const config::ConfigNode* options, const AvailableSignals& s,
-                                double false_alarm_share) {
+                                double false_alarm_share, const sim::RigDescription& rig) {
   IndexCusumOptions o;
+  o.rig = rig.params;
+  o.oil = rig.oil;
   read_learning(options, o.learning);
   read(options, "design_drop", o.design_drop, 0.005, 0.9);
   read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
@@ -134,7 +136,7 @@ IndexCusumOptions index_options(const config::ConfigNode* options, const Availab
   read(options, "drift_window_seconds", o.drift_window_seconds, 0.0, 3600.0);
   read(options, "supply_settle_seconds", o.supply_settle_seconds, 0.0, 3600.0);
   if (options != nullptr) {
-    o.oil = oil_of(*options);
+    o.oil = oil_of(*options, o.oil);
     if (o.min_drop >= o.design_drop) {
       const auto at = options->find("min_drop");
       (at ? *at : options->at("design_drop")).fail("min_drop must be below design_drop");
@@ -146,8 +148,11 @@ IndexCusumOptions index_options(const config::ConfigNode* options, const Availab
   return o;
 }
 
-FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {
+FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share,
+                                const sim::RigDescription& rig) {
   FlowBalanceOptions o;
+  o.rig = rig.params;
+  o.oil = rig.oil;
   read_learning(options, o.learning);
   read(options, "supply_pressure", o.rig.ps, 1e5, 1e9);
   read(options, "tank_pressure", o.rig.pt, 0.0, 1e8);
@@ -167,7 +172,7 @@ FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_
   read(options, "drift_window_seconds", o.drift_window_seconds, 1.0, 3600.0);
   if (options != nullptr) {
     o.estimate_supply = options->get_bool("estimate_supply", o.estimate_supply);
-    o.oil = oil_of(*options);
+    o.oil = oil_of(*options, o.oil);
   }
   o.false_alarms_per_hour *= false_alarm_share;
   return o;
@@ -192,9 +197,10 @@ PaperBaselineOptions paper_options(const config::ConfigNode* options, const Avai
 
 // design_shift / min_shift are in the feature's units: correlation with both chambers, ln of
 // the band ratio with one (detail_xcorr_detector.hpp).
-DetailXcorrOptions xcorr_options(const config::ConfigNode* options, const AvailableSignals& s) {
+DetailXcorrOptions xcorr_options(const config::ConfigNode* options, const AvailableSignals& s,
+                                 const sim::RigDescription& rig) {
   DetailXcorrOptions o;
-  o.test = index_options(options, s, 1.0);
+  o.test = index_options(options, s, 1.0, rig);
   // Two windows per block: the sliding feature's neighbouring blocks then share little data.
   o.test.block_seconds = kXcorrBlockSeconds;
   read(options, "block_seconds", o.test.block_seconds, 0.01, 60.0);
@@ -232,8 +238,10 @@ std::string default_detector_kind(const AvailableSignals& signals) {
 }
 
 std::unique_ptr<Detector> make_detector(const std::string& kind, const AvailableSignals& signals,
-                                        double hop_seconds, const config::ConfigNode* options) {
+                                        double hop_seconds, const config::ConfigNode* options,
+                                        const sim::RigDescription* rig) {
   if (!(hop_seconds > 0.0)) throw std::invalid_argument("detector hop must be positive");
+  const sim::RigDescription base = rig != nullptr ? *rig : sim::RigDescription::paper();
   const std::string resolved = kind == "default" ? default_detector_kind(signals) : kind;
   if (resolved == "paper") {
     require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
@@ -243,17 +251,19 @@ std::unique_ptr<Detector> make_detector(const std::string& kind, const Available
   if (resolved == "index_cusum") {
     require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
     expect_keys(options, {kLearningKeys, kIndexKeys});
-    return std::make_unique<IndexCusumDetector>(index_options(options, signals, 1.0), hop_seconds);
+    return std::make_unique<IndexCusumDetector>(index_options(options, signals, 1.0, base),
+                                                hop_seconds);
   }
   if (resolved == "detail_xcorr") {
     require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
     expect_keys(options, {kLearningKeys, kXcorrKeys});
-    return std::make_unique<DetailXcorrDetector>(xcorr_options(options, signals), hop_seconds);
+    return std::make_unique<DetailXcorrDetector>(xcorr_options(options, signals, base),
+                                                 hop_seconds);
   }
   if (resolved == "flow_balance") {
     require(has_all(signals), kind, "p1, p2, u and x");
     expect_keys(options, {kLearningKeys, kFlowKeys});
-    return std::make_unique<FlowBalanceDetector>(flow_options(options, 1.0), hop_seconds);
+    return std::make_unique<FlowBalanceDetector>(flow_options(options, 1.0, base), hop_seconds);
   }
   if (resolved == "fused") {
     require(has_all(signals), kind, "p1, p2, u and x");
@@ -261,9 +271,9 @@ std::unique_ptr<Detector> make_detector(const std::string& kind, const Available
     std::vector<std::unique_ptr<Detector>> members;
     // Flow balance first: it is the one that sizes the leak.
     members.push_back(
-        std::make_unique<FlowBalanceDetector>(flow_options(options, 0.5), hop_seconds));
-    members.push_back(
-        std::make_unique<IndexCusumDetector>(index_options(options, signals, 0.5), hop_seconds));
+        std::make_unique<FlowBalanceDetector>(flow_options(options, 0.5, base), hop_seconds));
+    members.push_back(std::make_unique<IndexCusumDetector>(
+        index_options(options, signals, 0.5, base), hop_seconds));
     return std::make_unique<FusedDetector>(std::move(members));
   }
   std::string known;
