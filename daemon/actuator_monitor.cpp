@@ -10,6 +10,7 @@
 
 #include "capture/units.hpp"
 #include "detect/factory.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -41,8 +42,7 @@ constexpr std::size_t kModeJudgedHops = 25;
 // The mode of a rig that `rig:` describes; NaN for the paper's (nothing stated).
 double rig_mode_hz(const sim::RigDescription& rig) {
   if (rig.nominal()) return kNaN;
-  const sim::Parameters& p = rig.params;
-  return ModeVisibilityCheck::mode_frequency_hz(p.beta, p.A(), p.V0(), p.m);
+  return sim::hydraulic_mode_hz(rig.params);
 }
 
 ModeVisibilityCheck mode_check(const detect::TransducerSpec& spec) {

@@ -22,7 +22,7 @@
 #include "daemon/sample.hpp"
 #include "detect/factory.hpp"
 #include "detect/rig_options.hpp"
-#include "sim/sensors.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -144,13 +144,13 @@ detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
   return spec;
 }
 
-// The pressure transducers a rig that states its supply is fitted with: 12 bit over the standard
-// range above its supply (MODEL.md's 0-20.7 MPa for the paper's 17.2 MPa), as the simulator
-// assumes for it.
+// The pressure transducers a rig that states its supply is fitted with: 12 bit over the usual
+// range above its supply (sim::sensors_for: MODEL.md's 0-20.7 MPa for the paper's 17.2 MPa), as
+// the simulator assumes for it.
 detect::TransducerSpec pressure_transducer_for(const sim::RigDescription& rig) {
   detect::TransducerSpec spec = detect::TransducerSpec::pressure();
   if (!rig.states("supply_pressure")) return spec;
-  spec.max = sim::standard_pressure_full_scale(rig.params.ps);
+  spec.max = sim::sensors_for(rig.params).pressure_full_scale;
   spec.resolution = spec.max / 4096.0;
   return spec;
 }

@@ -54,7 +54,7 @@ struct ActuatorConfig {
   // The rig's description (`rig:`, FORMATS.md): the base of the detector's supply, tank pressure,
   // valve, piston area, command full scale and oil, which detector options of the same values
   // override (detect/rig_options.hpp); the paper's rig when absent. A stated supply also sets
-  // the pressure transducers' default range (sim::standard_pressure_full_scale).
+  // the pressure transducers' default range (sim::sensors_for).
   sim::RigDescription rig;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
@@ -155,8 +155,7 @@ void check_channels(const DaemonConfig& config,
                     const std::vector<std::vector<std::string>>& driver_channels);
 
 // Sets the actuator's rig and what follows from it where nothing else is configured: the
-// pressure transducers' range (12 bit over sim::standard_pressure_full_scale of a stated
-// supply). `parse_config` calls it before it reads `transducers:`; `leakmon replay --rig` on the
+// pressure transducers' range (12 bit over sim::sensors_for's range for a stated supply). `parse_config` calls it before it reads `transducers:`; `leakmon replay --rig` on the
 // built-in defaults.
 void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig);
 

@@ -35,7 +35,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <numbers>
 
 namespace leakmon::daemon {
 
@@ -50,14 +49,6 @@ class ModeVisibilityCheck {
   // level-2 details of an orthonormal wavelet keep white noise's variance.
   static double noise_floor_pa(double sigma, double resolution) noexcept {
     return std::sqrt(sigma * sigma + resolution * resolution / 12.0);
-  }
-
-  // The hydraulic mode at mid-stroke [Hz]: the two oil columns (V1 = V2 = V0) against the moving
-  // mass, sqrt(beta A^2 (1/V1 + 1/V2) / m) / (2 pi); 73.5 Hz on MODEL.md's nominal rig.
-  static double mode_frequency_hz(double bulk_modulus, double area, double chamber_volume,
-                                  double mass) noexcept {
-    return std::sqrt(2.0 * bulk_modulus * area * area / (chamber_volume * mass)) /
-           (2.0 * std::numbers::pi);
   }
 
   // Where a mode still shows in the details of `level`: their band fs/2^(level+1)..fs/2^level

@@ -9,6 +9,7 @@
 
 #include "capture/units.hpp"
 #include "config/yaml_reader.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::sim {
 namespace {
@@ -369,7 +370,7 @@ Scenario read_scenario(const config::ConfigNode& root) {
     // The transducers a rig with this supply is fitted with, unless `sensors:` says otherwise
     // (the paper's 20.7 MPa for its 17.2 MPa).
     if (scenario.rig.states("supply_pressure")) {
-      scenario.sensors.pressure_full_scale = standard_pressure_full_scale(scenario.rig.params.ps);
+      scenario.sensors.pressure_full_scale = sensors_for(scenario.rig.params).pressure_full_scale;
     }
   }
   if (auto node = root.find("params")) read_parameters(*node, scenario.rig, scenario.params);

@@ -9,16 +9,6 @@ double SensorSettings::pressure_lsb() const {
   return pressure_full_scale / std::ldexp(1.0, pressure_bits);
 }
 
-double standard_pressure_full_scale(double supply_pressure) noexcept {
-  constexpr double kRanges[] = {6.9e6,  10e6, 13.8e6, 16e6, 20.7e6, 25e6,
-                                34.5e6, 40e6, 51.7e6, 60e6, 68.9e6, 100e6};
-  const double needed = 1.2 * supply_pressure;
-  for (const double range : kRanges) {
-    if (range >= needed) return range;
-  }
-  return std::ceil(needed / 10e6) * 10e6;
-}
-
 double quantise_pressure(const SensorSettings& s, double p) noexcept {
   const double lsb = s.pressure_lsb();
   const double top_code = std::ldexp(1.0, s.pressure_bits) - 1.0;

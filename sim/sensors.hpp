@@ -29,11 +29,6 @@ struct SensorSettings {
   double pressure_lsb() const;
 };
 
-// The pressure transducer range a rig with this supply [Pa] is fitted with: the smallest
-// standard range (1000-10000 psi and 100-1000 bar series) that reads 1.2 x the supply, so that
-// the chambers' pressure peaks stay inside it. 20.7 MPa (3000 psi) for the paper's 17.2 MPa.
-double standard_pressure_full_scale(double supply_pressure) noexcept;
-
 // The quantisers of the chain (also used to re-quantise a spiked reading).
 double quantise_pressure(const SensorSettings& s, double p) noexcept;  // clamped to the range
 double quantise_position(const SensorSettings& s, double x) noexcept;

@@ -33,6 +33,9 @@ struct EvaluationOptions {
   double after_fault_seconds = 90.0;
   // restart: how long the daemon watches a healthy rig after restarting.
   double after_restart_seconds = 300.0;
+  // "paper": rigs across MODEL.md's calibration spread of the paper's rig; "other": each run on
+  // a rig drawn by sim::draw_other_rig, leaks scaled to its valve (study/rig_cases.hpp).
+  std::string rigs = "paper";
   std::vector<int> keep_captures;  // run ids whose capture CSV is written into `out`
   std::filesystem::path out;
 };
