@@ -155,6 +155,7 @@ RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& opti
     if (event.kind != io::EventKind::alarm_raised) continue;
     if (event.alarm == "sensor_fault") {
       result.any_fault[c] = true;
+      if (result.first_fault.empty()) result.first_fault = event.channel + " " + event.fault;
       continue;
     }
     result.run.alarms[c][0].push_back({event.t, event.leak_coefficient});
@@ -294,7 +295,7 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
   auto runs = fmt::output_file((dir / "rigs_runs.tsv").string());
   runs.print(
       "run\tcontroller\tbore\trod\tstroke\tsupply\tKv\tmass\tspring\trest_load\tmode_hz\tleak\t"
-      "paper_equivalent_leak\tonset");
+      "paper_equivalent_leak\tonset\tsensor_fault");
   for (std::size_t c = 0; c < all.size(); ++c) {
     runs.print("\tr{}_{}_{}_delay\tr{}_size\tr{}_blind", c, all[c].label,
                all[c].told ? "told" : "not_told", c, c);
@@ -306,8 +307,9 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
     runs.print("{}\t{}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.4g}\t{:.4g}\t",
                spec.id, sim::to_string(spec.scenario.controller), p.D, p.d, p.L, p.ps, p.Kv, p.m,
                p.K_s, r.rest_load, r.mode_hz);
-    runs.print("{:.4g}\t{:.4g}\t{}", spec.leak, paper_equivalent_leak(spec),
-               spec.leak > 0.0 ? fmt::format("{:.3f}", spec.onset) : std::string(""));
+    runs.print("{:.4g}\t{:.4g}\t{}\t{}", spec.leak, paper_equivalent_leak(spec),
+               spec.leak > 0.0 ? fmt::format("{:.3f}", spec.onset) : std::string(""),
+               r.first_fault);
     for (std::size_t c = 0; c < all.size(); ++c) {
       // The first raise: its delay after the onset (negative: before it, a false alarm).
       const auto& alarms = r.run.alarms[c][0];

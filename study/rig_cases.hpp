@@ -59,6 +59,7 @@ struct RigRunResult {
   double rest_load = 0.0;       // rest_load_pressure [Pa]
   std::vector<bool> blind;      // per candidate: it announced detection_blind
   std::vector<bool> any_fault;  // per candidate: it raised a sensor_fault alarm
+  std::string first_fault;      // the first sensor_fault alarm's channel and kind, e.g. "p1 spikes"
 };
 
 RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& options);
