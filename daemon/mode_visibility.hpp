@@ -25,10 +25,11 @@
 //
 // On another rig the mode itself moves (MODEL.md "Other rigs": with m, A, beta and the volumes).
 // Far out of the band the index falls to the noise floor and the ratio says so; near the band's
-// edges it does not: a 50 mm bore with 80 kg (mode 44.5 Hz) kept the ratio above 2.5 while a
-// 3e-12 leak was found in 1 of 3 runs by either pressure-only detector (docs/detection.md, "Other
-// rigs"). So where the actuator's `rig:` describes the rig, its mode frequency at mid-stroke
-// decides too: outside readable_band() the rig is blind whatever the ratio.
+// edges it does not: a 50 mm bore with 80 kg (mode 44.8 Hz) kept the ratio above 2.5 while a
+// 3e-12 leak was found in none of 3 runs within 60 s by either pressure-only detector
+// (docs/detection.md, "Other rigs"). So where the actuator's `rig:` describes the rig, its mode
+// frequency at mid-stroke (sim::hydraulic_mode_hz) decides too: outside readable_band() the rig
+// is blind whatever the ratio.
 #pragma once
 
 #include <array>
@@ -53,9 +54,11 @@ class ModeVisibilityCheck {
 
   // Where a mode still shows in the details of `level`: their band fs/2^(level+1)..fs/2^level
   // widened to where db8's equivalent filter is 12 dB below its passband (0.74 x the lower and
-  // 1.22 x the upper edge: 46.5 and 153 Hz at level 2 and 500 Hz). Measured on simulated rigs
-  // with a 3e-12 leak (docs/detection.md, "Other rigs"): modes of 48-145 Hz were found by both
-  // pressure-only detectors in every run, 44.5 Hz in 1 of 3, 42 Hz and below in none.
+  // 1.22 x the upper edge: 46.25 and 152.5 Hz at level 2 and 500 Hz). Measured on simulated rigs
+  // with a 3e-12 leak, three seeds each (docs/tools/mode_band_sweep.py; docs/detection.md, "Other
+  // rigs"), raised within the 90 s after the onset: modes of 48-146 Hz 26/30 (detail_xcorr) and
+  // 29/30 (index_cusum), 44.8 Hz 1/3 each (after 69 and 85 s), 42 Hz and below none; at 154 Hz
+  // the index ratio already calls the rig blind.
   struct Band {
     double low, high;
   };

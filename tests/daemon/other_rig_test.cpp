@@ -107,8 +107,9 @@ bool blind(const ReplayResult& result) {
 
 // 80 kg on a 50 mm bore: the mode at 45 Hz, below the 46-153 Hz the level-2 details read. Its
 // index still stands more than 2.5 x above the transducer's noise, so the index alone does not
-// call the rig blind, but a 3e-12 leak was found in 1 of 3 runs (docs/detection.md, "Other
-// rigs"): told the rig, the daemon says detection_blind, naming the mode's frequency.
+// call the rig blind, but a 3e-12 leak was found within 60 s in none of 3 runs
+// (docs/detection.md, "Other rigs"): told the rig, the daemon says detection_blind, naming the
+// mode's frequency.
 TEST(OtherRigModeVisibility, AModeBelowTheBandIsBlindWhenTheRigIsDescribed) {
   const sim::RigDescription rig = rig_of("{bore: 0.05, rod: 0.028, stroke: 0.5, moving_mass: 80}");
   const double mode = sim::hydraulic_mode_hz(rig.params);
