@@ -58,6 +58,7 @@ int run_sim(int argc, char** argv) {
   } else {
     scenario = sim::load_scenario(*scenario_path);  // config::ConfigError: file:line:column
     if (args.has("seed")) scenario.seed = seed;
+    for (const auto& warning : scenario.warnings) fmt::print(stderr, "warning: {}\n", warning);
   }
   if (args.has("duration")) {
     const double duration = args.get_double("duration");

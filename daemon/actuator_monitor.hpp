@@ -150,7 +150,8 @@ class ActuatorMonitor {
   void judge_mode_visibility(double t, const detect::Observation& observation,
                              const EventPublisher& publish);
   bool detection_blind() const {
-    return watch_mode_ && healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio;
+    return watch_mode_ &&
+           (mode_out_of_band_ || healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio);
   }
 
   ActuatorConfig config_;
@@ -193,6 +194,10 @@ class ActuatorMonitor {
   // Only for a detector that needs the hydraulic mode (watch_mode_): p1's and p2's checks.
   bool watch_mode_;
   std::array<ModeVisibilityCheck, 2> mode_checks_;
+  // The described rig's mode (NaN for the paper's rig, whose mode is not in question) and
+  // whether it lies outside what the index reads (ModeVisibilityCheck::readable_band).
+  double rig_mode_hz_;
+  bool mode_out_of_band_;
   bool mode_judged_ = false;
   double healthy_index_ratio_ = io::kNoValue;
   bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision

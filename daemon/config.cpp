@@ -28,6 +28,8 @@
 #include "detect/factory.hpp"
 #include "io/modbus/modbus_config.hpp"
 #include "io/modbus/modbus_link.hpp"
+#include "detect/rig_options.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -184,9 +186,39 @@ detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
   return spec;
 }
 
+// The pressure transducers a rig that states its supply is fitted with: 12 bit over the usual
+// range above its supply (sim::sensors_for: MODEL.md's 0-20.7 MPa for the paper's 17.2 MPa), as
+// the simulator assumes for it.
+detect::TransducerSpec pressure_transducer_for(const sim::RigDescription& rig) {
+  detect::TransducerSpec spec = detect::TransducerSpec::pressure();
+  if (!rig.states("supply_pressure")) return spec;
+  spec.max = sim::sensors_for(rig.params).pressure_full_scale;
+  spec.resolution = spec.max / 4096.0;
+  return spec;
+}
+
+// A detector option that restates a value of the actuator's `rig:` overrides it: valid, but the
+// two places may disagree, so say where both are.
+void warn_restated(const ActuatorConfig& actuator, const config::ConfigNode& rig_node,
+                   std::vector<std::string>& warnings) {
+  if (!actuator.detector_options) return;
+  for (const auto& restated :
+       detect::restated_rig_values(*actuator.detector_options, actuator.rig)) {
+    std::string places;
+    for (const auto& key : restated.rig_keys) {
+      if (!places.empty()) places += ", ";
+      places += fmt::format("{} at {}", key, rig_node.at(key).location());
+    }
+    warnings.push_back(fmt::format(
+        "{}: {}: actuator '{}': also given in its rig: ({}); the detector uses this option. Give "
+        "the value once, in rig:",
+        restated.option.location(), restated.option.path(), actuator.name, places));
+  }
+}
+
 ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
-                              std::set<std::string>& names) {
-  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers"});
+                              std::set<std::string>& names, std::vector<std::string>& warnings) {
+  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers", "rig"});
   ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
@@ -223,6 +255,11 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
       detector->fail(fmt::format("unknown detector '{}' (known: {})", actuator.detector,
                                  fmt::join(kinds, ", ")));
     }
+  }
+  const auto rig = node.find("rig");
+  if (rig) {
+    apply_rig(actuator, sim::read_rig(*rig));
+    warn_restated(actuator, *rig, warnings);
   }
   if (auto alarm = node.find("alarm")) {
     actuator.alarm = parse_alarm(*alarm);
@@ -271,6 +308,11 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
 
 }  // namespace
 
+void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig) {
+  actuator.rig = std::move(rig);
+  actuator.p1_transducer = actuator.p2_transducer = pressure_transducer_for(actuator.rig);
+}
+
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver) {
   for (const auto& group : config.groups) {
     if (std::find(group.drivers.begin(), group.drivers.end(), driver) != group.drivers.end()) {
@@ -318,7 +360,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
   std::set<std::string> actuator_names;
   const auto actuators = root.at("actuators");
   for (const auto& node : actuators.items()) {
-    config.actuators.push_back(parse_actuator(node, config, actuator_names));
+    config.actuators.push_back(parse_actuator(node, config, actuator_names, config.warnings));
   }
   if (config.actuators.empty()) actuators.fail("at least one actuator is needed");
 
@@ -444,7 +486,8 @@ void check_channels(const DaemonConfig& config,
                                static_cast<double>(group ? group->period_ns : 2'000'000) / 1e9;
     try {
       detect::make_detector(actuator.detector, signals, hop_seconds,
-                            actuator.detector_options ? &*actuator.detector_options : nullptr);
+                            actuator.detector_options ? &*actuator.detector_options : nullptr,
+                            &actuator.rig);
     } catch (const std::invalid_argument& e) {
       throw config::ConfigError(
           fmt::format("{}: actuator '{}': {}", config.source, actuator.name, e.what()));

@@ -14,6 +14,7 @@
 #include "daemon/alarm.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::daemon {
 
@@ -50,11 +51,17 @@ struct ActuatorConfig {
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;
+  // The rig's description (`rig:`, FORMATS.md): the base of the detector's supply, tank pressure,
+  // valve, piston area, command full scale and oil, which detector options of the same values
+  // override (detect/rig_options.hpp); the paper's rig when absent. A stated supply also sets
+  // the pressure transducers' default range (sim::sensors_for).
+  sim::RigDescription rig;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   std::string alarm_name = "internal_leakage";
   // The transducers behind p1, p2 and x, for their plausibility checks (`transducers:`);
-  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise.
+  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise
+  // (pressures 12 bit over the rig's standard range when `rig:` states the supply).
   detect::TransducerSpec p1_transducer = detect::TransducerSpec::pressure();
   detect::TransducerSpec p2_transducer = detect::TransducerSpec::pressure();
   detect::TransducerSpec x_transducer = detect::TransducerSpec::position();
@@ -96,8 +103,9 @@ struct DaemonConfig {
   std::vector<ActuatorConfig> actuators;
   std::string event_log;  // JSON-lines file; empty: none
   std::optional<config::ConfigNode> event_log_where;
-  // Legal but probably wrong (two Modbus channels on the same registers), each
-  // `file:line:column: message`; filled by check_config(), printed by check-config, logged by run.
+  // Legal but probably wrong (two Modbus channels on the same registers, a value given both in
+  // `rig:` and in the detector's options), each `file:line:column: message`; check-config prints
+  // them, run logs them at start.
   std::vector<std::string> warnings;
   RecordingConfig recording;
   StateConfig state{config::default_state_directory(), 60.0, std::nullopt};
@@ -149,6 +157,11 @@ void check_peers(const DaemonConfig& config);
 // offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.
 void check_channels(const DaemonConfig& config,
                     const std::vector<std::vector<std::string>>& driver_channels);
+
+// Sets the actuator's rig and what follows from it where nothing else is configured: the
+// pressure transducers' range (12 bit over sim::sensors_for's range for a stated supply). `parse_config` calls it before it reads `transducers:`; `leakmon replay --rig` on the
+// built-in defaults.
+void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig);
 
 // The group that holds `driver`, or nullptr.
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);

@@ -105,6 +105,7 @@ void Daemon::start() {
   config_ = check_config(config_path_);
   spdlog::info("configuration {}: {} driver(s), {} sampling group(s), {} actuator(s)", config_path_,
                config_.drivers.size(), config_.groups.size(), config_.actuators.size());
+  for (const auto& warning : config_.warnings) spdlog::warn("{}", warning);
 
   // Threads inherit the blocked control signals: only the main thread receives them.
   const sigset_t signals = control_signals();
@@ -187,7 +188,6 @@ void Daemon::start() {
                  config_.state.directory, config_.state.save_seconds);
   }
 
-  for (const auto& warning : config_.warnings) spdlog::warn("{}", warning);
   // Which detector runs for each actuator, and how long it learns before it can raise alarms.
   for (const auto& status : worker_->status()) {
     for (const auto& actuator : config_.actuators) {

@@ -70,9 +70,9 @@ std::vector<Option<O>> supply_settle_options() {
 }
 
 // The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
-// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; VG 46 when
-// neither is given.
-sim::Oil oil_of(const config::ConfigNode& options) {
+// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; the rig's oil
+// (VG 46 unless its description says otherwise) when neither is given.
+sim::Oil oil_of(const config::ConfigNode& options, const sim::Oil& rig_oil) {
   const auto grade = options.find("oil_grade");
   const auto nu40 = options.find("oil_viscosity_40");
   const auto nu100 = options.find("oil_viscosity_100");
@@ -91,7 +91,7 @@ sim::Oil oil_of(const config::ConfigNode& options) {
     if (!(a > b)) nu100->fail("oil_viscosity_100 must be below oil_viscosity_40");
     return sim::Oil(a, b);
   }
-  return sim::Oil::standard();
+  return rig_oil;
 }
 
 template <class O>
@@ -99,13 +99,22 @@ std::vector<Option<O>> oil_options() {
   return {other_option<O>("oil_grade", "46", "32, 46, 68",
                           "ISO VG grade of the oil (the viscosity ratio with a `temp` channel)",
                           [](O& o, const config::ConfigNode* node, const Option<O>&) {
-                            if (node != nullptr) o.oil = oil_of(*node);
+                            if (node != nullptr) o.oil = oil_of(*node, o.oil);
                           }),
           other_option<O>("oil_viscosity_40", "-", "1 to 10000",
                           "instead of oil_grade: the data sheet's viscosity at 40 degC [mm^2/s]",
                           nullptr),
           other_option<O>("oil_viscosity_100", "-", "0.5 to 1000",
                           "with oil_viscosity_40: the viscosity at 100 degC [mm^2/s]", nullptr)};
+}
+
+// The options' starting point on the actuator's rig: its supply, tank, command full scale,
+// valve, piston area and oil, which the options restating them override (rig_options.hpp).
+template <class O>
+O on_rig(O options, const sim::RigDescription& rig) {
+  if constexpr (requires { options.rig; }) options.rig = rig.params;
+  if constexpr (requires { options.oil; }) options.oil = rig.oil;
+  return options;
 }
 
 // Reads the rows, then the checks across options that only a configured mapping can fail.
@@ -148,7 +157,8 @@ void check_paper(const PaperBaselineOptions& o, const config::ConfigNode& node) 
   }
 }
 
-PaperBaselineOptions paper_options(const config::ConfigNode* node, const AvailableSignals& s) {
+PaperBaselineOptions paper_options(const config::ConfigNode* node, const AvailableSignals& s,
+                                   const sim::RigDescription&) {
   PaperBaselineOptions o;
   o.use_p2 = !s.p1;
   return read_checked(paper_rows(), o, node, check_paper);
@@ -185,8 +195,9 @@ void check_index(const IndexCusumOptions& o, const config::ConfigNode& node) {
 }
 
 IndexCusumOptions index_options(const config::ConfigNode* node, const AvailableSignals& s,
-                                double false_alarm_share) {
-  IndexCusumOptions o = read_checked(index_rows(), IndexCusumOptions{}, node, check_index);
+                                double false_alarm_share, const sim::RigDescription& rig) {
+  IndexCusumOptions o =
+      read_checked(index_rows(), on_rig(IndexCusumOptions{}, rig), node, check_index);
   o.false_alarms_per_hour *= false_alarm_share;
   o.use_p1 = s.p1;
   o.use_p2 = s.p2;
@@ -207,9 +218,22 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
          std::vector<Option<O>>{
              number_option<O>("command_full_scale", 1e-3, 1e3, "valve command full scale [V]",
                               [](O& o) -> double& { return o.rig.u_max; }),
-             number_option<O>("valve_coefficient", 1e-12, 1.0,
-                              "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]",
-                              [](O& o) -> double& { return o.rig.Kv; }),
+             // A leak of interest is a share of the valve's flow (the test works in command
+             // units, MODEL.md "Other rigs"): design_leak's and min_leak's defaults are the
+             // paper's valve's, scaled to this one (their rows below take a configured value as
+             // it is).
+             other_option<O>(
+                 "valve_coefficient", "", "",
+                 "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]; design_leak's and min_leak's "
+                 "defaults scale with it",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr)
+                     o.rig.Kv = node->get_double(row.key, o.rig.Kv, row.lo, row.hi);
+                   const double valve_share = o.rig.Kv / sim::Parameters::nominal().Kv;
+                   o.design_leak = O{}.design_leak * valve_share;
+                   o.min_leak = O{}.min_leak * valve_share;
+                 },
+                 1e-12, 1.0, [](O& o) { return option_number_text(o.rig.Kv); }),
              number_option<O>("valve_coefficient_uncertainty", 0.0, 1.0,
                               "relative uncertainty of Kv (in the leak size's interval)",
                               [](O& o) -> double& { return o.valve_coefficient_uncertainty; }),
@@ -251,9 +275,10 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
          oil_options<O>();
 }
 
-FlowBalanceOptions flow_options(const config::ConfigNode* node, double false_alarm_share) {
-  FlowBalanceOptions o =
-      read_checked<FlowBalanceOptions>(flow_rows(), FlowBalanceOptions{}, node, nullptr);
+FlowBalanceOptions flow_options(const config::ConfigNode* node, double false_alarm_share,
+                                const sim::RigDescription& rig) {
+  FlowBalanceOptions o = read_checked<FlowBalanceOptions>(
+      flow_rows(), on_rig(FlowBalanceOptions{}, rig), node, nullptr);
   o.false_alarms_per_hour *= false_alarm_share;
   return o;
 }
@@ -311,8 +336,9 @@ void check_xcorr(const DetailXcorrOptions& o, const config::ConfigNode& node) {
   }
 }
 
-DetailXcorrOptions xcorr_options(const config::ConfigNode* node, const AvailableSignals& s) {
-  DetailXcorrOptions o;
+DetailXcorrOptions xcorr_options(const config::ConfigNode* node, const AvailableSignals& s,
+                                 const sim::RigDescription& rig) {
+  DetailXcorrOptions o = on_rig(DetailXcorrOptions{}, rig);
   o.use_p1 = s.p1;
   o.use_p2 = s.p2;
   return read_checked(xcorr_rows(), o, node, check_xcorr);
@@ -337,23 +363,27 @@ std::vector<std::string> fused_keys() {
 
 // A kind that is one detector: its options read through its table by Read, then built.
 template <class D, class O, std::vector<Option<O>> (*Rows)(),
-          O (*Read)(const config::ConfigNode*, const AvailableSignals&)>
+          O (*Read)(const config::ConfigNode*, const AvailableSignals&, const sim::RigDescription&)>
 DetectorKind single_kind(std::string_view name, std::string_view needs,
                          bool (*runs_on)(const AvailableSignals&)) {
   return {name,
           needs,
           runs_on,
           [] { return option_keys(Rows()); },
-          [](const AvailableSignals& s, double hop, const config::ConfigNode* node)
-              -> std::unique_ptr<Detector> { return std::make_unique<D>(Read(node, s), hop); },
+          [](const AvailableSignals& s, double hop, const config::ConfigNode* node,
+             const sim::RigDescription& rig) -> std::unique_ptr<Detector> {
+            return std::make_unique<D>(Read(node, s, rig), hop);
+          },
           [] { return options_markdown(Rows()); }};
 }
 
-IndexCusumOptions index_alone(const config::ConfigNode* node, const AvailableSignals& s) {
-  return index_options(node, s, 1.0);
+IndexCusumOptions index_alone(const config::ConfigNode* node, const AvailableSignals& s,
+                              const sim::RigDescription& rig) {
+  return index_options(node, s, 1.0, rig);
 }
-FlowBalanceOptions flow_alone(const config::ConfigNode* node, const AvailableSignals&) {
-  return flow_options(node, 1.0);
+FlowBalanceOptions flow_alone(const config::ConfigNode* node, const AvailableSignals&,
+                              const sim::RigDescription& rig) {
+  return flow_options(node, 1.0, rig);
 }
 
 }  // namespace
@@ -368,13 +398,15 @@ std::vector<DetectorKind> detector_registry() {
       single_kind<FlowBalanceDetector, FlowBalanceOptions, flow_rows, flow_alone>("flow_balance",
                                                                                   kAll, has_all),
       {"fused", kAll, has_all, fused_keys,
-       [](const AvailableSignals& s, double hop,
-          const config::ConfigNode* node) -> std::unique_ptr<Detector> {
+       [](const AvailableSignals& s, double hop, const config::ConfigNode* node,
+          const sim::RigDescription& rig) -> std::unique_ptr<Detector> {
          std::vector<std::unique_ptr<Detector>> members;
          // Flow balance first: it is the one that sizes the leak. Each member gets half the
          // false-alarm budget, so the union keeps the target rate.
-         members.push_back(std::make_unique<FlowBalanceDetector>(flow_options(node, 0.5), hop));
-         members.push_back(std::make_unique<IndexCusumDetector>(index_options(node, s, 0.5), hop));
+         members.push_back(
+             std::make_unique<FlowBalanceDetector>(flow_options(node, 0.5, rig), hop));
+         members.push_back(
+             std::make_unique<IndexCusumDetector>(index_options(node, s, 0.5, rig), hop));
          return std::make_unique<FusedDetector>(std::move(members));
        },
        [] {
@@ -406,8 +438,10 @@ std::string default_detector_kind(const AvailableSignals& signals) {
 }
 
 std::unique_ptr<Detector> make_detector(const std::string& kind, const AvailableSignals& signals,
-                                        double hop_seconds, const config::ConfigNode* options) {
+                                        double hop_seconds, const config::ConfigNode* options,
+                                        const sim::RigDescription* rig) {
   if (!(hop_seconds > 0.0)) throw std::invalid_argument("detector hop must be positive");
+  const sim::RigDescription base = rig != nullptr ? *rig : sim::RigDescription::paper();
   const std::string resolved = kind == "default" ? default_detector_kind(signals) : kind;
   for (const auto& entry : detector_registry()) {
     if (entry.name != resolved) continue;
@@ -415,7 +449,7 @@ std::unique_ptr<Detector> make_detector(const std::string& kind, const Available
       throw std::invalid_argument("detector '" + kind + "' needs " + std::string(entry.needs));
     }
     if (options != nullptr) options->expect_keys(entry.option_keys());
-    return entry.build(signals, hop_seconds, options);
+    return entry.build(signals, hop_seconds, options, base);
   }
   std::string known;
   for (const auto& k : detector_kinds()) known += (known.empty() ? "" : ", ") + k;

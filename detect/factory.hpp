@@ -11,6 +11,7 @@
 
 #include "config/yaml_reader.hpp"
 #include "detect/detector.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::detect {
 
@@ -28,7 +29,8 @@ struct DetectorKind {
   std::vector<std::string> (*option_keys)();
   // Options read (and checked) from `options` (null: defaults), the detector built.
   std::unique_ptr<Detector> (*build)(const AvailableSignals&, double hop_seconds,
-                                     const config::ConfigNode* options);
+                                     const config::ConfigNode* options,
+                                     const sim::RigDescription& rig);
   std::string (*options_reference)();  // Markdown, for docs/detection.md
 };
 
@@ -37,10 +39,14 @@ std::vector<DetectorKind> detector_registry();
 
 // kind: one of detector_kinds(). hop_seconds: time between observations. options: the
 // detector's mapping from the configuration, or null for defaults; unknown keys and
-// out-of-range values throw config::ConfigError naming file:line:column. Throws
-// std::invalid_argument for an unknown kind or when the signals the kind needs are missing.
+// out-of-range values throw config::ConfigError naming file:line:column. rig: the actuator's
+// description (`rig:`), or null for the paper's rig: the base of the detector's supply, tank,
+// command full scale, valve, piston area and oil, which the options of detect/rig_options.hpp
+// override. Throws std::invalid_argument for an unknown kind or when the signals the kind needs
+// are missing.
 std::unique_ptr<Detector> make_detector(const std::string& kind, const AvailableSignals& signals,
-                                        double hop_seconds, const config::ConfigNode* options);
+                                        double hop_seconds, const config::ConfigNode* options,
+                                        const sim::RigDescription* rig = nullptr);
 
 std::vector<std::string> detector_kinds();
 

@@ -50,8 +50,10 @@ struct FlowBalanceOptions {
   double valve_coefficient_uncertainty = 0.1;  // relative
   // A hop is at rest when |dx/dt| stays below rest_speed over it and both its neighbours: a hop
   // that holds the first or last few samples of a move carries flows the balance does not model.
-  double rest_speed = 2e-3;      // [m/s]
-  double design_leak = 2.5e-13;  // C_L the CUSUM is tuned for [m^3/(s Pa)]
+  double rest_speed = 2e-3;  // [m/s]
+  // C_L the CUSUM is tuned for [m^3/(s Pa)]; the factory scales this default and min_leak's by
+  // the valve's Kv over the paper's 3.39e-7 (a leak of interest is a share of the valve's flow).
+  double design_leak = 2.5e-13;
   double false_alarms_per_hour = 0.05;
   double block_seconds = 0.8;
   double min_rest_fraction = 0.25;  // a block needs this share of hops at rest

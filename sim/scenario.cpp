@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "capture/units.hpp"
 #include "config/yaml_reader.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::sim {
 namespace {
@@ -378,6 +380,43 @@ std::vector<SensorFault> read_faults(const config::ConfigNode& node,
   return faults;
 }
 
+// The reference against what the rig can do (reference_reach): an error beyond the end stops
+// or nearly all of the rig's force, a warning where tracking suffers. Reported at the
+// reference's amp_max when given, else at the rig (or params) that makes it too much.
+void check_reach(const config::ConfigNode& root, Scenario& scenario) {
+  const ReferenceReach reach = reference_reach(scenario.params, scenario.reference);
+  std::optional<config::ConfigNode> at;
+  if (auto reference = root.find("reference")) at = reference->find("amp_max");
+  if (!at) at = root.find("rig");
+  if (!at) at = root.find("params");
+  if (!at) at = root;
+  const double amplitude_mm = scenario.reference.amp_max * 1e3;
+  const std::string stroke =
+      fmt::format("the reference's steps reach {:.4g} mm, {:.0f} % of the half stroke ({:.4g} mm)",
+                  amplitude_mm, 100.0 * reach.stroke_share, scenario.params.L * 500.0);
+  const std::string force = fmt::format(
+      "the load spring needs {:.4g} kN at the reference's largest step ({:.4g} mm), {:.0f} % of "
+      "the {:.4g} kN the piston can make (A (ps - pt))",
+      scenario.params.K_s * scenario.reference.amp_max * 1e-3, amplitude_mm,
+      100.0 * reach.force_share,
+      scenario.params.A() * (scenario.params.ps - scenario.params.pt) * 1e-3);
+  if (reach.stroke_share >= kStrokeShareError) {
+    at->fail(stroke + ": beyond the end stops; lower reference.amp_max or state the stroke");
+  }
+  if (reach.force_share > kForceShareError) {
+    at->fail(force + ": the rig cannot follow it; lower reference.amp_max");
+  }
+  if (reach.stroke_share > kStrokeShareWarning) {
+    scenario.warnings.push_back(
+        fmt::format("{}: {}: overshoot may hit the end stops", at->location(), stroke));
+  }
+  if (reach.force_share > kForceShareWarning) {
+    scenario.warnings.push_back(fmt::format(
+        "{}: {}: above about half the rig tracks the steps poorly (MODEL.md \"Other rigs\")",
+        at->location(), force));
+  }
+}
+
 Scenario read_scenario(const config::ConfigNode& root) {
   root.expect_keys({"name", "controller", "duration_s", "seed", "sample_rate_hz",
                     "integration_step_s", "reference", "program", "rig", "params", "effects",
@@ -394,11 +433,17 @@ Scenario read_scenario(const config::ConfigNode& root) {
     scenario.rig = read_rig(*node);
     scenario.params = scenario.rig.params;
     scenario.conditions.oil = scenario.rig.oil;
+    // The transducers a rig with this supply is fitted with, unless `sensors:` says otherwise
+    // (the paper's 20.7 MPa for its 17.2 MPa).
+    if (scenario.rig.states("supply_pressure")) {
+      scenario.sensors.pressure_full_scale = sensors_for(scenario.rig.params).pressure_full_scale;
+    }
   }
   if (auto node = root.find("params")) read_parameters(*node, scenario.rig, scenario.params);
   if (auto node = root.find("program")) scenario.program = read_program(*node, scenario.params);
   if (auto node = root.find("effects")) read_effects(*node, scenario.effects);
   if (auto node = root.find("sensors")) read_sensors(*node, scenario.sensors);
+  check_reach(root, scenario);
   if (auto node = root.find("conditions")) {
     read_conditions(*node, scenario.rig, scenario.conditions);
   }
@@ -432,6 +477,13 @@ Scenario paper_experiment(std::string_view name, ControllerKind controller, doub
 }
 
 }  // namespace
+
+ReferenceReach reference_reach(const Parameters& params, const ReferenceSettings& reference) {
+  ReferenceReach reach;
+  reach.stroke_share = reference.amp_max / (0.5 * params.L);
+  reach.force_share = params.K_s * reference.amp_max / (params.A() * (params.ps - params.pt));
+  return reach;
+}
 
 std::uint64_t Scenario::samples() const {
   return static_cast<std::uint64_t>(std::llround(duration_s * sample_rate_hz));

@@ -52,11 +52,27 @@ struct Scenario {
   double sample_rate_hz = 500.0;
   // RK4 step; 0 chooses automatic_integration_step(). Must divide the sample period.
   double integration_step_s = 0.0;
+  // What a scenario file asks for that the rig may not manage (reference_reach()), for
+  // `leakmon sim` to print; each "file:line:column: message".
+  std::vector<std::string> warnings;
 
   std::uint64_t samples() const;  // rows of the capture: duration * rate, rounded
 };
 
 double integration_step(const Scenario& scenario);  // explicit value or the automatic one
+
+// How far the rig can follow the steps' largest amplitude (MODEL.md "Other rigs"): that
+// amplitude as a share of half the stroke (1 or more: beyond the end stops), and the spring's
+// force there, K_s amp_max, as a share of the force A (ps - pt) the rig can make (a load that
+// needs more than about half of it cannot track the reference).
+struct ReferenceReach {
+  double stroke_share = 0.0;
+  double force_share = 0.0;
+};
+ReferenceReach reference_reach(const Parameters& params, const ReferenceSettings& reference);
+// Beyond these a scenario file is an error; above the warning shares `leakmon sim` warns.
+inline constexpr double kStrokeShareError = 1.0, kStrokeShareWarning = 0.8;
+inline constexpr double kForceShareError = 0.9, kForceShareWarning = 0.5;
 
 // Throws config::ConfigError ("file:line:column: path: message") on any bad input.
 Scenario load_scenario(const std::string& path);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <utility>
 
+#include "study/rig_cases.hpp"
+
 namespace leakmon::study {
 namespace {
 
@@ -373,6 +375,7 @@ RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
                  },
              },
              condition.kind);
+  if (options.rigs == "other") use_other_rig(run);
   std::mt19937_64 operating_draws(seed ^ 0x6a09e667f3bcc909ULL);
   run.sensor_fault_run = std::holds_alternative<SensorFaultCondition>(condition.kind);
   apply_operating(condition.operating, operating_draws, run.monitor_from,

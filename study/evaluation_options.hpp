@@ -36,6 +36,9 @@ struct EvaluationOptions {
   // programs and wear: phase lengths and wear durations are MODEL.md's typical values times this
   // (1; smaller for a quick check).
   double time_scale = 1.0;
+  // "paper": rigs across MODEL.md's calibration spread of the paper's rig; "other": each run on
+  // a rig drawn by sim::draw_other_rig, leaks scaled to its valve (study/rig_cases.hpp).
+  std::string rigs = "paper";
   std::vector<int> keep_captures;  // run ids whose capture CSV is written into `out`
   std::filesystem::path out;
 };

@@ -336,3 +336,84 @@ TEST(DaemonConfig, NamesWithControlCharactersAreRejectedAndEscaped) {
 
 }  // namespace
 }  // namespace leakmon::daemon
+
+namespace leakmon::daemon {
+namespace {
+
+// An actuator's `rig:` (FORMATS.md): read with the one rig reader, its supply sets the pressure
+// transducers' default range, and a value given both there and in the detector's options is
+// valid but warned about, naming both places.
+TEST(DaemonConfig, AnActuatorsRigIsReadAndSetsTheTransducersRange) {
+  const auto config = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) +
+          "actuators:\n"
+          "  - name: a\n"
+          "    channels: {p1: p1, p2: p2}\n"
+          "    rig: {bore: 0.05, rod: 0.028, supply_pressure: 21.0e6, valve_coefficient: 5.3e-7}\n"
+          "  - name: b\n"
+          "    channels: {p1: p1}\n"
+          "    rig: {supply_pressure: 21.0e6}\n"
+          "    transducers: {p1: {max: 40.0e6}}\n"
+          "  - name: c\n"
+          "    channels: {p1: p1}\n",
+      "rig.yaml"));
+  const auto& a = config.actuators.at(0);
+  EXPECT_EQ(a.rig.stated,
+            (std::vector<std::string>{"bore", "rod", "supply_pressure", "valve_coefficient"}));
+  EXPECT_DOUBLE_EQ(a.rig.params.ps, 21.0e6);
+  EXPECT_DOUBLE_EQ(a.rig.params.Kv, 5.3e-7);
+  EXPECT_EQ(a.rig.source, "rig.yaml:5:10");
+  // 21 MPa: the 25 MPa range (sim::sensors_for), 12 bit, for both chambers.
+  EXPECT_DOUBLE_EQ(a.p1_transducer.max, 25e6);
+  EXPECT_DOUBLE_EQ(a.p2_transducer.resolution, 25e6 / 4096.0);
+  // A configured transducer range wins; without a rig, MODEL.md's 20.7 MPa.
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).p1_transducer.max, 40e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).p2_transducer.max, 25e6);
+  EXPECT_TRUE(config.actuators.at(2).rig.nominal());
+  EXPECT_DOUBLE_EQ(config.actuators.at(2).p1_transducer.max, 20.7e6);
+  EXPECT_TRUE(config.warnings.empty());
+
+  const std::string e = error_of(std::string(kDriver) +
+                                 "actuators:\n"
+                                 "  - name: a\n"
+                                 "    channels: {p1: p1}\n"
+                                 "    rig:\n"
+                                 "      bore: 0.05\n"
+                                 "      supply: 21.0e6\n");
+  EXPECT_NE(e.find("rig.yaml:7:15"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown rig key 'supply'"), std::string::npos) << e;
+}
+
+TEST(DaemonConfig, AValueInBothTheRigAndTheDetectorOptionsIsWarnedAboutWithBothPlaces) {
+  const auto config = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) + "actuators:\n"
+                             "  - name: a\n"
+                             "    channels: {p1: p1, p2: p2, u: u, x: x}\n"
+                             "    rig:\n"
+                             "      bore: 0.05\n"
+                             "      supply_pressure: 21.0e6\n"
+                             "      valve_rated_flow: 1.0e-3\n"
+                             "      valve_rated_pressure_drop: 7.0e6\n"
+                             "    detector:\n"
+                             "      kind: flow_balance\n"
+                             "      options:\n"
+                             "        supply_pressure: 20.0e6\n"
+                             "        valve_coefficient: 5.0e-7\n"
+                             "        piston_area: 1.3e-3\n"
+                             "        min_leak: 1.0e-13\n",
+      "rig.yaml"));
+  ASSERT_EQ(config.warnings.size(), 3u);
+  const std::string& supply = config.warnings[0];
+  EXPECT_EQ(supply.rfind("rig.yaml:13:26: ", 0), 0u) << supply;
+  EXPECT_NE(supply.find("supply_pressure at rig.yaml:7:24"), std::string::npos) << supply;
+  EXPECT_NE(supply.find("actuator 'a'"), std::string::npos) << supply;
+  EXPECT_NE(config.warnings[1].find("valve_rated_flow at rig.yaml:8:25"), std::string::npos)
+      << config.warnings[1];
+  // The piston area restates the bore (the rod is the paper's, unstated).
+  EXPECT_NE(config.warnings[2].find("bore at rig.yaml:6:13"), std::string::npos)
+      << config.warnings[2];
+  EXPECT_EQ(config.warnings[2].find("rod at"), std::string::npos) << config.warnings[2];
+}
+
+}  // namespace
+}  // namespace leakmon::daemon
