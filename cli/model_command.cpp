@@ -18,6 +18,8 @@
 #include "model/measured_record.hpp"
 #include "model/report.hpp"
 #include "model/result_json.hpp"
+#include "model/rig_source.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::cli {
 namespace {
@@ -29,18 +31,44 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 int run_check(int argc, char** argv) {
-  ArgParser args("model check",
-                 "Calibrates beta, Kv, m, b on the fitting part of a capture, extends the model\n"
-                 "with each effect of MODEL.md's library, scores each on held-out data and names\n"
-                 "the best when its gain is significant (else `none`). Writes FORMATS.md's JSON.");
+  ArgParser args(
+      "model check",
+      "Checks the rig's stated values that the capture can check (supply, load\n"
+      "stiffness), calibrates beta, Kv, m, b around the stated ones on the fitting part\n"
+      "of a capture, extends the model with each effect of MODEL.md's library, scores\n"
+      "each on held-out data and names the best when its gain is significant (else\n"
+      "`none`). Writes FORMATS.md's JSON. Without --rig or --config the rig is the\n"
+      "paper's (MODEL.md's nominal values).");
   args.option("data", "CAPTURE.csv", "capture with at least t,u,x,p1,p2 at 500 Hz", std::nullopt,
               true)
       .option("json", "RESULT.json", "where to write the result", std::nullopt, true)
+      .option("rig", "RIG.yaml", "the rig's description: a file whose top-level key is rig:", "")
+      .option("config", "CONFIG.yaml", "the daemon's configuration: take --actuator's rig:", "")
+      .option("actuator", "NAME", "the actuator of --config whose rig: to take", "")
       .option("report", "DIR", "also write a Markdown report with plots into DIR", "");
   if (!args.parse(argc, argv, 2)) return 0;
+  const std::string rig_file = args.get("rig");
+  const std::string config_file = args.get("config");
+  const std::string actuator = args.get("actuator");
+  if (!rig_file.empty() && !config_file.empty()) {
+    throw UsageError("give the rig once: --rig RIG.yaml or --config CONFIG.yaml --actuator NAME");
+  }
+  if (config_file.empty() != actuator.empty()) {
+    throw UsageError(
+        "--config and --actuator go together: the actuator of the configuration "
+        "whose rig: the capture was recorded on");
+  }
+  sim::RigDescription rig = sim::RigDescription::paper();
+  if (!rig_file.empty()) rig = sim::load_rig_file(rig_file);
+  if (!config_file.empty()) rig = model::load_actuator_rig(config_file, actuator);
   const model::MeasuredRecord record = model::read_measured_record(args.get("data"));
-  const model::Diagnosis d = model::diagnose(record);
+  fmt::print("rig: {}\n", sim::describe(rig));
+  const model::Diagnosis d = model::diagnose(record, rig);
   write_text(args.get("json"), model::diagnosis_json(d));
+  for (const auto& finding : d.rig_check.findings) {
+    fmt::print("stated {} {:.4g} contradicted by the data: {:.4g}\n", finding.parameter,
+               finding.stated, finding.fitted);
+  }
   fmt::print("cause: {} (held-out NRMSE {:.4f} -> {:.4f})\n", d.cause, d.nrmse_before,
              d.nrmse_after);
   if (const auto dir = args.get("report"); !dir.empty()) {
@@ -116,7 +144,9 @@ int run_evaluate_cases(int argc, char** argv) {
 
 int run_model(int argc, char** argv) {
   const std::string_view usage =
-      "usage: leakmon model check --data CAPTURE.csv --json RESULT.json [--report DIR]\n"
+      "usage: leakmon model check --data CAPTURE.csv --json RESULT.json\n"
+      "                           [--rig RIG.yaml | --config CONFIG.yaml --actuator NAME]\n"
+      "                           [--report DIR]\n"
       "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n"
       "                              [--classes LIST]\n";
   if (argc < 2) throw UsageError(std::string(usage));

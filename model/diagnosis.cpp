@@ -110,8 +110,22 @@ std::vector<NamedValue> named_values(const EffectCandidate& c, const FitResult& 
 
 }  // namespace
 
+NamedCause rig_cause(const RigFinding& finding) {
+  return {"rig_parameter",
+          {{"parameter", 0.0, 0.0, finding.parameter},
+           {"stated", finding.stated, 0.0, ""},
+           {"fitted", finding.fitted, finding.error, ""}},
+          0.0};
+}
+
 Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settings) {
+  return diagnose(record, sim::RigDescription::paper(), settings);
+}
+
+Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
+                   const DiagnosisSettings& settings) {
   Diagnosis d;
+  d.rig = rig;
   d.plan = split_record(record, settings.split);
   if (d.plan.fitting.size() < 4 || d.plan.held_out.size() < 4) {
     throw ModelCheckError(fmt::format(
@@ -121,7 +135,44 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   }
   d.fitting_used = spread(d.plan.fitting, settings.max_fitting_segments);
   d.held_out_used = spread(d.plan.held_out, settings.max_held_out_segments);
-  const SegmentPredictor predictor(record);
+
+  // The stated values first: a contradicted one is corrected before any effect is judged, and
+  // named when the corrected rig's calibrated nominal model predicts the held-out data better.
+  d.rig_check = check_rig(record, d.plan.fitting, rig.params, settings.rig);
+  if (!d.rig_check.findings.empty()) {
+    // The calibrated nominal model on a rig: m from the force balance where usable.
+    const auto calibrated_nominal = [&](const sim::Parameters& on) {
+      const SegmentPredictor p(record, on);
+      FitSettings fs = settings.fit;
+      fs.stated = Calibration::of(on);
+      Calibration start = Calibration::of(on);
+      const ForceBalance fb = estimate_force_balance(record, d.plan.fitting, on);
+      if (settings.use_force_balance && usable(fb, on.m)) {
+        start.m = fb.m;
+        start.b = fb.b;
+        fs.free_calibration = {true, true, false, true};
+      }
+      const FitResult fit = fit_model(p, d.fitting_used, nullptr, start, fs);
+      return std::pair{segment_errors(p, fit.parameters, d.held_out_used),
+                       p.nrmse(fit.parameters, d.held_out_used)};
+    };
+    const auto [stated_errors, stated_nrmse] = calibrated_nominal(d.rig_check.stated);
+    const auto [corrected_errors, corrected_nrmse] = calibrated_nominal(d.rig_check.assumed);
+    d.nrmse_stated = stated_nrmse;
+    d.nrmse_corrected = corrected_nrmse;
+    d.rig_score = 1.0 - std::exp(-mean_log_ratio(stated_errors, corrected_errors));
+    d.rig_significance = std::max(paired_t(stated_errors, corrected_errors),
+                                  trimmed_t(stated_errors, corrected_errors));
+    if (d.rig_score < settings.min_score || d.rig_significance < settings.min_significance ||
+        corrected_nrmse >= stated_nrmse) {
+      d.rig_rejected = std::move(d.rig_check.findings);
+      d.rig_check.findings.clear();
+      d.rig_check.assumed = d.rig_check.stated;
+    }
+  }
+  const sim::Parameters& assumed = d.rig_check.assumed;
+  const Calibration stated_calibration = Calibration::of(assumed);
+  const SegmentPredictor predictor(record, assumed);
 
   // Only a line that passes its second-half test is worth a ripple candidate: without one the
   // ripple fit would merely chase the tallest noise peak.
@@ -129,15 +180,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   d.min_line_z = settings.min_line_z;
   d.ripple_line_significant = d.ripple_line && d.ripple_line->held_out_z >= settings.min_line_z;
   const auto library = effect_library(d.ripple_line_significant ? d.ripple_line->frequency_hz : 0.0,
-                                      !record.temp.empty(), record.dt);
+                                      !record.temp.empty(), record.dt, assumed);
 
   // m from the measured force balance, where it is usable: the simulation fit then calibrates
   // beta, Kv and b (from the force balance's b), and cannot slide along the beta/m/b valley.
   // b stays free: in the force balance it shares the moving windows with the friction term.
-  d.force_balance = estimate_force_balance(record, d.plan.fitting);
-  Calibration catalogue;  // MODEL.md's values, m and b measured when possible
+  d.force_balance = estimate_force_balance(record, d.plan.fitting, assumed);
+  Calibration catalogue = stated_calibration;  // the rig's values, m and b measured if possible
   FitSettings fit_settings = settings.fit;
-  if (settings.use_force_balance && usable(d.force_balance)) {
+  fit_settings.stated = stated_calibration;
+  if (settings.use_force_balance && usable(d.force_balance, assumed.m)) {
     catalogue.m = d.force_balance.m;
     catalogue.b = d.force_balance.b;
     fit_settings.free_calibration = {true, true, false, true};
@@ -169,7 +221,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // A calibration on its bounds is the model compensating for something it lacks (a strong
   // droop drove beta, Kv and b to their limits): retry from the calibrations that the best
   // screened effect candidates reached, moved inside the bounds.
-  d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration);
+  d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration, stated_calibration);
   if (!d.nominal_at_bound.empty()) {
     std::vector<const FitResult*> starts;
     for (const auto& fit : screened) starts.push_back(&fit);
@@ -177,11 +229,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
                      [](const FitResult* a, const FitResult* b) { return a->cost < b->cost; });
     starts.resize(std::min<std::size_t>(starts.size(), 3));
     for (const FitResult* start : starts) {
-      FitResult retry = fit_model(predictor, d.fitting_used, nullptr,
-                                  within_bounds(start->parameters.calibration), fit_settings);
+      FitResult retry =
+          fit_model(predictor, d.fitting_used, nullptr,
+                    within_bounds(start->parameters.calibration, stated_calibration), fit_settings);
       if (retry.cost < nominal.cost) nominal = std::move(retry);
     }
-    d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration);
+    d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration, stated_calibration);
   }
   d.nominal = nominal.parameters;
   // What a correct model would score on these held-out segments, from the capture's own
@@ -237,7 +290,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     p.calibration = calibration;
     std::vector<double> values;
     for (const auto& fp : candidate.parameters) values.push_back(fp.initial);
-    candidate.apply(p.effects, values);
+    candidate.apply(p, values);
     double sum = 0.0;
     for (double e : segment_errors(predictor, p, d.fitting_used)) sum += e;
     return sum;
@@ -438,7 +491,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   }
   if (!fit_settings.free_calibration[2]) d.calibrated_errors.m = d.force_balance.m_error;
   d.nrmse_after = predictor.nrmse(d.extended, d.held_out_used);
-  d.at_bound = calibration_at_bound(d.calibrated);
+  d.at_bound = calibration_at_bound(d.calibrated, stated_calibration);
 
   // Drift: the calibration fitted on the first and on the last third of the capture. Where it
   // moves, a named cause must hold still over the capture too, or the misfit is a changing
@@ -545,6 +598,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
         d.drifts ||
         (std::abs(d.unexplained->trend_t) > 3.0 &&
          (d.unexplained->late_over_early > 2.0 || d.unexplained->late_over_early < 0.5));
+  }
+  // A contradicted stated value is a cause of its own, ahead of the effects judged on the
+  // corrected rig (FORMATS.md); the comparison starts from the rig the user described.
+  if (!d.rig_check.findings.empty()) {
+    std::vector<NamedCause> rig_causes;
+    for (const auto& finding : d.rig_check.findings) rig_causes.push_back(rig_cause(finding));
+    d.causes.insert(d.causes.begin(), rig_causes.begin(), rig_causes.end());
+    d.cause = d.causes.front().effect;
+    d.params = d.causes.front().params;
+    d.nrmse_before = d.nrmse_stated;
   }
   return d;
 }

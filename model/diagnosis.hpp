@@ -13,8 +13,10 @@
 #include "model/force_balance.hpp"
 #include "model/measured_record.hpp"
 #include "model/misfit.hpp"
+#include "model/rig_check.hpp"
 #include "model/segment_predictor.hpp"
 #include "model/spectral_line.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::model {
 
@@ -79,6 +81,10 @@ struct DiagnosisSettings {
   double drift_z = 4.0;
   double drift_calibration_relative = 0.1;
   double drift_effect_relative = 0.3;
+  // The stated values the data can check (rig_check.hpp); a finding is named only when the
+  // corrected rig's calibrated nominal model also predicts the held-out data better than the
+  // stated rig's, with step 1's score and significance.
+  RigCheckSettings rig;
 };
 
 // One step of the forward selection: the best candidate tried at that step and its held-out
@@ -92,8 +98,9 @@ struct SelectionStep {
 };
 
 struct NamedCause {
-  std::string effect;
+  std::string effect;  // an effect of the library, or "rig_parameter"
   std::vector<NamedValue> params;
+  double onset_s = 0.0;  // > 0: the effect starts at this capture time (FORMATS.md `onset_s`)
 };
 
 // A parameter fitted on the first and on the last third of the capture.
@@ -105,6 +112,16 @@ struct DriftComparison {
 };
 
 struct Diagnosis {
+  // The rig as described (`--rig`; the paper's when none is given) and the check of its stated
+  // values: `rig_check.assumed` is the rig every model below runs on.
+  sim::RigDescription rig;
+  RigCheck rig_check;
+  // Held-out NRMSE of the calibrated nominal model on the stated rig and on the corrected one
+  // (both only computed when the rig check found something; nrmse_before is then the stated
+  // rig's, the model the user described).
+  double nrmse_stated = 0.0, nrmse_corrected = 0.0;
+  double rig_score = 0.0, rig_significance = 0.0;  // the correction's held-out gain
+  std::vector<RigFinding> rig_rejected;  // findings the held-out comparison did not confirm
   std::string cause = "none";
   std::vector<NamedValue> params;  // the cause's parameters with standard errors
   Calibration calibrated;          // of the reported model (the cause's fit, or nominal)
@@ -131,6 +148,15 @@ struct Diagnosis {
   bool drifts = false;                        // the model's parameters change over the capture
 };
 
+// On the paper's rig (MODEL.md's nominal values).
 Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settings = {});
+// On the rig as described: the stated values are checked first (rig_check.hpp), beta, Kv, m
+// and b are calibrated around the stated ones, and the effects are judged on the rig as
+// corrected.
+Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
+                   const DiagnosisSettings& settings = {});
+
+// The `causes` entry of a rig finding: parameter, stated and fitted (FORMATS.md).
+NamedCause rig_cause(const RigFinding& finding);
 
 }  // namespace leakmon::model

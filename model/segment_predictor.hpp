@@ -96,7 +96,10 @@ class SegmentPredictor {
                                     std::uint64_t seed, int repeats = 3) const;
 
  private:
-  std::vector<double> spool_positions(const ActuatorModel& model) const;
+  // `before`: the model up to onset_s, when an effect starts inside the capture.
+  std::vector<double> spool_positions(const ActuatorModel& model,
+                                      const ActuatorModel* before = nullptr,
+                                      double onset_s = 0.0) const;
   template <typename Visit>
   void run(const ModelParameters& parameters, std::span<const Segment> segments,
            Visit&& visit) const;
