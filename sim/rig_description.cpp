@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace leakmon::sim {
 
@@ -205,6 +206,20 @@ std::optional<double> rig_value(const RigDescription& rig, std::string_view key)
     if (oil->nu40() == rig.oil.nu40() && oil->nu100() == rig.oil.nu100()) return grade;
   }
   return std::nullopt;
+}
+
+RigDescription with_value(const RigDescription& rig, std::string_view key, double value) {
+  const RigKey* spec = key_named(key);
+  RigDescription out = rig;
+  if (spec != nullptr && !spec->symbol.empty()) {
+    *parameter_of(out.params, spec->symbol) = value;
+  } else if (key == "valve_rated_flow") {
+    out.params.Kv = kv_from_rating(value, out.valve_rated_pressure_drop);
+  } else {
+    throw std::invalid_argument(fmt::format("rig key '{}' cannot be set to a number", key));
+  }
+  if (!out.states(key)) out.stated.emplace_back(key);
+  return out;
 }
 
 std::string describe(const RigDescription& rig) {

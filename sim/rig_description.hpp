@@ -67,6 +67,11 @@ RigDescription load_rig_file(const std::string& path);
 // unknown key or an oil_grade of a custom oil.
 std::optional<double> rig_value(const RigDescription& rig, std::string_view key);
 
+// `rig` with `key` (a rig_keys() key that names a MODEL.md symbol, or valve_rated_flow at the
+// stated rated drop) set to `value` and marked stated. Throws std::invalid_argument for an
+// unknown key or an oil key.
+RigDescription with_value(const RigDescription& rig, std::string_view key, double value);
+
 // One line for logs, reports and `leakmon sim`: "bore 50 mm, rod 28 mm, supply 21 MPa, ..."
 // with the stated keys only, or "the paper's rig (MODEL.md nominal)" when nothing is stated.
 std::string describe(const RigDescription& rig);
