@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "model/diagnosis.hpp"
@@ -91,15 +92,28 @@ int run_evaluate_cases(int argc, char** argv) {
       .option("duration", "SECONDS", "length of each simulated capture", "60")
       .option("classes", "LIST",
               "comma-separated case classes, taken in turn: library (the eleven effects and "
-              "none), pair, warmup_temp, warmup_no_temp, edge, beyond, clean",
+              "none), pair, warmup_temp, warmup_no_temp, edge, beyond, clean, misstated (a "
+              "stated value wrong), onset (an effect appearing inside the capture)",
               "library")
-      .option("out", "DIR", "output directory", std::nullopt, true);
+      .option("rigs", "WHICH",
+              "paper (MODEL.md's rig) or other (rigs drawn from MODEL.md's 'Other rigs' "
+              "ranges, each told its description; classes misstated and onset as well)",
+              "paper")
+      .option("out", "DIR", "output directory", std::nullopt, true)
+      .flag("keep-captures",
+            "also write each case's capture (OUT/case-SEED.csv) and the rig it was told "
+            "(OUT/case-SEED-rig.yaml), for `leakmon model check --rig`");
   if (!args.parse(argc, argv, 2)) return 0;
   const long long cases = args.get_int("cases");
   if (cases < 1) throw UsageError("option '--cases': must be at least 1");
   const auto first = static_cast<std::uint64_t>(args.get_int("seed"));
   model::CaseSettings case_settings;
   case_settings.duration_s = args.get_double("duration");
+  const std::string rigs = args.get("rigs");
+  if (rigs != "paper" && rigs != "other") {
+    throw UsageError(fmt::format("option '--rigs': '{}' is neither paper nor other", rigs));
+  }
+  case_settings.other_rig = rigs == "other";
   std::vector<std::string> kinds;
   const std::string list = args.get("classes");
   for (std::size_t begin = 0; begin <= list.size();) {
@@ -112,12 +126,19 @@ int run_evaluate_cases(int argc, char** argv) {
     kinds.push_back(kind);
     begin = end + 1;
   }
+  const std::string dir = args.get("out");
+  std::filesystem::create_directories(dir);
   model::EvaluationSummary summary;
   for (long long i = 0; i < cases; ++i) {
     const auto index = static_cast<std::size_t>(i);
     const auto& kind = kinds[index % kinds.size()];
     const auto [effect, settings] = model::case_of_kind(kind, index / kinds.size(), case_settings);
     const auto seed = first + static_cast<std::uint64_t>(i);
+    if (args.flag_set("keep-captures")) {
+      const model::SyntheticCase c = model::draw_case(seed, effect, settings);
+      capture::write_capture(fmt::format("{}/case-{}.csv", dir, seed), model::simulate_case(c));
+      write_text(fmt::format("{}/case-{}-rig.yaml", dir, seed), model::rig_file_text(c.told));
+    }
     summary.cases.push_back(model::evaluate_case(seed, effect, settings));
     summary.cases.back().kind = kind;
     const auto& c = summary.cases.back();
@@ -128,10 +149,18 @@ int run_evaluate_cases(int argc, char** argv) {
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z);
     fmt::print("  {} causes [{}] floor {:.4f} true {:.4f} achieved {:.2f} drifts {} steps {}\n",
                c.kind, c.causes, c.nrmse_floor, c.nrmse_true, c.achieved, c.drifts, c.steps);
+    if (case_settings.other_rig || !c.misstated.empty() || c.onset_true > 0.0) {
+      std::string findings;
+      for (const auto& f : c.rig_findings) {
+        findings += fmt::format(" {} {:.4g}->{:.4g}", f.parameter, f.stated, f.fitted);
+      }
+      fmt::print(
+          "  rig {}; misstated {} (true {:.4g} told {:.4g}); found{}; onset {:.2f} -> {:.2f}\n",
+          c.rig, c.misstated.empty() ? "-" : c.misstated, c.misstated_true, c.misstated_stated,
+          findings.empty() ? " nothing" : findings, c.onset_true, c.onset_estimate);
+    }
     std::fflush(stdout);
   }
-  const std::string dir = args.get("out");
-  std::filesystem::create_directories(dir);
   write_text(dir + "/cases.csv", summary.csv());
   const std::string markdown =
       summary.targets_markdown() + "\n" + summary.kind_markdown() + "\n" + summary.markdown();
@@ -148,7 +177,7 @@ int run_model(int argc, char** argv) {
       "                           [--rig RIG.yaml | --config CONFIG.yaml --actuator NAME]\n"
       "                           [--report DIR]\n"
       "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n"
-      "                              [--classes LIST]\n";
+      "                              [--classes LIST] [--rigs paper|other]\n";
   if (argc < 2) throw UsageError(std::string(usage));
   const std::string_view action = argv[1];
   if (action == "-h" || action == "--help") {

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
+#include "model/change_point.hpp"
 #include "model/force_balance.hpp"
 #include "model/spectral_line.hpp"
 
@@ -241,10 +243,43 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // transducer noise and the spool flow noise.
   d.noise = predictor.noise_levels();
   d.channel_floor =
-      predictor.noise_floor(nominal.parameters, d.held_out_used, d.noise, settings.floor_seed);
+      predictor.noise_floor(nominal.parameters, d.held_out_used, d.noise, settings.floor_seed,
+                            settings.floor_repeats, settings.floor_noise_pieces);
   d.nrmse_floor = (d.channel_floor[0] + d.channel_floor[1] + d.channel_floor[2]) / 3.0;
   const std::vector<double> nominal_errors =
       segment_errors(predictor, nominal.parameters, d.held_out_used);
+
+  // Effects that start inside the capture: where the calibrated nominal model's error steps up
+  // at some time and stays up, the leading screened effects are also fitted from that time on
+  // (onset variants, judged on held-out data against the constant ones like any variant).
+  std::vector<EffectCandidate> candidates = library;
+  const std::vector<Segment> in_time = segments_in_time_order(d.plan);
+  {
+    const auto errors = segment_errors(predictor, nominal.parameters, in_time);
+    std::vector<double> logs;
+    for (double e : errors) logs.push_back(std::log(std::max(e, 1e-300)));
+    d.change_point = find_change_point(record, in_time, logs);
+  }
+  if (d.change_point && d.change_point->statistic >= settings.min_change_statistic) {
+    std::vector<std::size_t> order(library.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return screened[a].cost < screened[b].cost;
+    });
+    std::vector<std::string> tried;
+    for (const std::size_t i : order) {
+      const auto& base = library[i];
+      // A ripple is found by its line, the oil by its temperature: neither starts at a time.
+      if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
+      if (std::find(tried.begin(), tried.end(), base.effect) != tried.end()) continue;
+      if (tried.size() >= settings.onset_candidates) break;
+      tried.push_back(base.effect);
+      EffectCandidate variant = base;
+      variant.onset_s = d.change_point->t_s;
+      screened.push_back(fit_model(predictor, screening_segments, &variant, catalogue, screening));
+      candidates.push_back(std::move(variant));
+    }
+  }
 
   const auto score = [&](const EffectCandidate& candidate, FitResult fit) {
     RankedEffect r;
@@ -260,8 +295,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // Best variant of each effect (e.g. the chamber that leaks), by held-out error.
   std::map<std::string, RankedEffect> best;
   std::map<std::string, EffectCandidate> best_candidate;
-  for (std::size_t i = 0; i < library.size(); ++i) {
-    const auto& candidate = library[i];
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const auto& candidate = candidates[i];
     RankedEffect r = score(candidate, std::move(screened[i]));
     auto it = best.find(candidate.effect);
     if (it == best.end() || r.score > it->second.score) {
@@ -465,6 +500,39 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     current = std::move(best_fit);
   }
 
+  // An effect named with an onset: the onset refined to the sample on every segment around it
+  // (fitting and held-out alike, the time is not a model parameter the held-out score judges),
+  // the named model's error summed over them for each trial onset.
+  if (named) {
+    for (auto& part : chosen) {
+      if (part.onset_s <= 0.0) continue;
+      std::vector<Segment> near;
+      for (const auto& seg : in_time) {
+        const double begin = record.t[seg.begin];
+        const double end = begin + static_cast<double>(seg.length) * record.dt;
+        if (end > part.onset_s - settings.onset_search_s - 0.5 &&
+            begin < part.onset_s + settings.onset_search_s + 0.5) {
+          near.push_back(seg);
+        }
+      }
+      ModelParameters trial = current.parameters;
+      double best_onset = part.onset_s, best_error = std::numeric_limits<double>::infinity();
+      const double step = settings.onset_step_s;
+      const auto steps = static_cast<int>(std::lround(settings.onset_search_s / step));
+      for (int i = -steps; i <= steps; ++i) {
+        trial.onset_s = part.onset_s + i * step;
+        if (trial.onset_s <= record.t.front()) continue;
+        double sum = 0.0;
+        for (double e : segment_errors(predictor, trial, near)) sum += e;
+        if (sum < best_error) {
+          best_error = sum;
+          best_onset = trial.onset_s;
+        }
+      }
+      part.onset_s = best_onset;
+    }
+  }
+
   FitSettings with_errors = fit_settings;
   with_errors.uncertainties = true;
   if (named) {
@@ -477,7 +545,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       FitResult part;
       part.values = shares[p];
       part.value_errors = share_errors[p];
-      d.causes.push_back({chosen[p].effect, named_values(chosen[p], part)});
+      d.causes.push_back({chosen[p].effect, named_values(chosen[p], part), chosen[p].onset_s});
     }
     d.cause = d.causes.front().effect;
     d.params = d.causes.front().params;
@@ -536,7 +604,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   std::array<double, 3> extended_floor = d.channel_floor;
   if (named) {
     extended_floor =
-        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed);
+        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed,
+                              settings.floor_repeats, settings.floor_noise_pieces);
   }
   const double extended_reach =
       settings.floor_factor * (extended_floor[0] + extended_floor[1] + extended_floor[2]) / 3.0;
@@ -553,8 +622,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     const EffectCandidate joint = chosen.size() == 1 ? chosen.front() : combine(chosen);
     const FitResult fe = fit_model(predictor, early, &joint, d.calibrated, with_errors);
     const FitResult fl = fit_model(predictor, late, &joint, d.calibrated, with_errors);
-    cause_moves = compare(joint.parameters.front().name, fe.values[0], fe.value_errors[0],
-                          fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
+    // A cause with an onset is absent from the thirds before it: its main parameter is not
+    // asked to hold still, its model's calibration is (below).
+    if (chosen.front().onset_s <= 0.0) {
+      cause_moves = compare(joint.parameters.front().name, fe.values[0], fe.value_errors[0],
+                            fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
+    }
     // The named model's own calibration moving as the nominal one did: the constant fault
     // named does not account for the change, the oil's properties (beta, the damping b) do
     // (warm-ups without `temp` were named sensor_offset or entrained_air, the misfit left

@@ -154,6 +154,12 @@ std::string diagnosis_json(const Diagnosis& d) {
   }
   out += "],\n";
   out += fmt::format("  \"nrmse_floor\": {},\n", number(d.nrmse_floor));
+  if (d.change_point) {
+    out +=
+        fmt::format("  \"change_point\": {{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}},\n",
+                    number(d.change_point->t_s), number(d.change_point->statistic),
+                    number(d.change_point->step));
+  }
   out += fmt::format("  \"unexplained\": {},\n",
                      d.unexplained ? misfit_object(*d.unexplained) : "null");
   out += fmt::format("  \"at_bound\": {},\n", string_list(d.at_bound));

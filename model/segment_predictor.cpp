@@ -277,7 +277,7 @@ NoiseLevels SegmentPredictor::noise_levels() const {
 std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& parameters,
                                                     std::span<const Segment> segments,
                                                     const NoiseLevels& noise, std::uint64_t seed,
-                                                    int repeats) const {
+                                                    int repeats, int pieces) const {
   const ActuatorModel model(parameters, rig_);
   const std::vector<double> xs = spool_positions(model);
   std::mt19937_64 random(seed);
@@ -315,9 +315,25 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
       guess.p1 += noise.p1 * normal(random);
       guess.p2 += noise.p2 * normal(random);
       double w = w_sigma * normal(random);
+      // Finer: the process itself at the pieces' spacing, each piece holding the mean of its
+      // two ends (the simulator interpolates its noise grid linearly).
+      const double piece = record_.dt / pieces;
+      const double piece_rho = std::exp(-piece / std::max(noise.spool_tau, 1e-9));
+      const double piece_innovation =
+          noise.spool_sigma * std::sqrt(std::max(1.0 - piece_rho * piece_rho, 0.0));
+      double w_end = noise.spool_sigma * normal(random);
       for (std::size_t j = 1; j < seg.length; ++j) {
         const std::size_t k = k0 + j;
-        model.advance(truth, record_.u[k - 1], record_.t[k - 1], record_.dt, w);
+        if (pieces <= 1) {
+          model.advance(truth, record_.u[k - 1], record_.t[k - 1], record_.dt, w);
+        } else {
+          for (int i = 0; i < pieces; ++i) {
+            const double w_start = w_end;
+            w_end = piece_rho * w_end + piece_innovation * normal(random);
+            model.advance(truth, record_.u[k - 1], record_.t[k - 1] + i * piece, piece,
+                          0.5 * (w_start + w_end));
+          }
+        }
         model.advance(guess, record_.u[k - 1], record_.t[k - 1], record_.dt);
         w = rho * w + w_innovation * normal(random);
         const Reading t = model.read(truth);
