@@ -251,30 +251,48 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
 
   // Effects that start inside the capture: where the calibrated nominal model's error steps up
   // at some time and stays up, the leading screened effects are also fitted from that time on
-  // (onset variants, judged on held-out data against the constant ones like any variant).
+  // (onset variants, judged on held-out data against the constant ones like any variant). A
+  // segment's error follows its operating point (a large step against a rest) far more than a
+  // fault's onset, so the split is also sought in what a leading (constant) candidate gains
+  // per segment over the nominal model: about nothing before the onset, and its gain after it.
   std::vector<EffectCandidate> candidates = library;
   const std::vector<Segment> in_time = segments_in_time_order(d.plan);
+  std::vector<std::size_t> order(library.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return screened[a].cost < screened[b].cost;
+  });
+  // The leading screened effects, one variant each; neither a ripple (found by its line) nor
+  // the oil (by its temperature) starts at a time.
+  std::vector<std::size_t> leading;
+  for (const std::size_t i : order) {
+    const auto& base = library[i];
+    if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
+    const bool seen = std::any_of(leading.begin(), leading.end(),
+                                  [&](std::size_t j) { return library[j].effect == base.effect; });
+    if (!seen) leading.push_back(i);
+    if (leading.size() >= settings.onset_candidates) break;
+  }
   {
     const auto errors = segment_errors(predictor, nominal.parameters, in_time);
     std::vector<double> logs;
     for (double e : errors) logs.push_back(std::log(std::max(e, 1e-300)));
     d.change_point = find_change_point(record, in_time, logs);
+    for (std::size_t k = 0; k < std::min(leading.size(), settings.change_candidates); ++k) {
+      const auto gained = segment_errors(predictor, screened[leading[k]].parameters, in_time);
+      std::vector<double> gains;
+      for (std::size_t i = 0; i < gained.size(); ++i) {
+        gains.push_back(logs[i] - std::log(std::max(gained[i], 1e-300)));
+      }
+      const auto split = find_change_point(record, in_time, gains);
+      if (split && (!d.change_point || split->statistic > d.change_point->statistic)) {
+        d.change_point = split;
+      }
+    }
   }
   if (d.change_point && d.change_point->statistic >= settings.min_change_statistic) {
-    std::vector<std::size_t> order(library.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return screened[a].cost < screened[b].cost;
-    });
-    std::vector<std::string> tried;
-    for (const std::size_t i : order) {
-      const auto& base = library[i];
-      // A ripple is found by its line, the oil by its temperature: neither starts at a time.
-      if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
-      if (std::find(tried.begin(), tried.end(), base.effect) != tried.end()) continue;
-      if (tried.size() >= settings.onset_candidates) break;
-      tried.push_back(base.effect);
-      EffectCandidate variant = base;
+    for (const std::size_t i : leading) {
+      EffectCandidate variant = library[i];
       variant.onset_s = d.change_point->t_s;
       screened.push_back(fit_model(predictor, screening_segments, &variant, catalogue, screening));
       candidates.push_back(std::move(variant));
@@ -500,9 +518,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     current = std::move(best_fit);
   }
 
-  // An effect named with an onset: the onset refined to the sample on every segment around it
-  // (fitting and held-out alike, the time is not a model parameter the held-out score judges),
-  // the named model's error summed over them for each trial onset.
+  // An effect named with an onset: the onset searched on every segment around the proposal
+  // (fitting and held-out alike: the time is not a model parameter the held-out score judges),
+  // the named model's error summed over them for each trial onset. An effect that shows only
+  // while the piston moves (a slower spool, a dead band) changes nothing during a hold, where
+  // the sum is flat: the onset is then the middle of the flat stretch around the minimum (the
+  // change is known to within it, not better).
   if (named) {
     for (auto& part : chosen) {
       if (part.onset_s <= 0.0) continue;
@@ -516,20 +537,29 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
         }
       }
       ModelParameters trial = current.parameters;
-      double best_onset = part.onset_s, best_error = std::numeric_limits<double>::infinity();
       const double step = settings.onset_step_s;
       const auto steps = static_cast<int>(std::lround(settings.onset_search_s / step));
+      std::vector<std::pair<double, double>> sums;  // onset, summed error
       for (int i = -steps; i <= steps; ++i) {
         trial.onset_s = part.onset_s + i * step;
-        if (trial.onset_s <= record.t.front()) continue;
+        if (trial.onset_s <= record.t.front() || trial.onset_s >= record.t.back()) continue;
         double sum = 0.0;
         for (double e : segment_errors(predictor, trial, near)) sum += e;
-        if (sum < best_error) {
-          best_error = sum;
-          best_onset = trial.onset_s;
-        }
+        sums.emplace_back(trial.onset_s, sum);
       }
-      part.onset_s = best_onset;
+      if (sums.empty()) continue;
+      std::size_t lowest = 0;
+      for (std::size_t i = 1; i < sums.size(); ++i) {
+        if (sums[i].second < sums[lowest].second) lowest = i;
+      }
+      double highest = sums[lowest].second;
+      for (const auto& [onset, sum] : sums) highest = std::max(highest, sum);
+      const double flat =
+          sums[lowest].second + settings.onset_flat_share * (highest - sums[lowest].second);
+      std::size_t first = lowest, last = lowest;
+      while (first > 0 && sums[first - 1].second <= flat) --first;
+      while (last + 1 < sums.size() && sums[last + 1].second <= flat) ++last;
+      part.onset_s = 0.5 * (sums[first].first + sums[last].first);
     }
   }
 

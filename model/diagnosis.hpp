@@ -90,13 +90,19 @@ struct DiagnosisSettings {
   double drift_calibration_relative = 0.1;
   double drift_effect_relative = 0.3;
   // Effects that start inside the capture: a change point of the nominal model's per-segment
-  // errors with a Welch t of at least this (change_point.hpp) has the leading screened effects
-  // tried from it on too; a named one's onset is then searched within +-onset_search_s of it
-  // in steps of onset_step_s.
+  // errors, or of a leading screened effect's per-segment gain over it, with a Welch t of at
+  // least this (change_point.hpp) has the leading screened effects tried from it on too; a named
+  // one's onset is then searched within +-onset_search_s of it in steps of onset_step_s.
   double min_change_statistic = 5.0;
   std::size_t onset_candidates = 4;
-  double onset_search_s = 1.0;
-  double onset_step_s = 0.02;
+  std::size_t change_candidates = 3;  // leading effects whose per-segment gain is split too
+  double onset_search_s = 4.0;
+  double onset_step_s = 0.05;
+  // Trial onsets whose summed error lies within this share of the search's range (largest
+  // minus smallest) above the smallest form the flat stretch whose middle is the onset (an
+  // effect invisible during a hold; the closed loop's small corrections during it make the
+  // stretch differ by a few per cent, the step into it by orders of magnitude).
+  double onset_flat_share = 0.02;
   // The stated values the data can check (rig_check.hpp); a finding is named only when the
   // corrected rig's calibrated nominal model also predicts the held-out data better than the
   // stated rig's, with step 1's score and significance.

@@ -50,7 +50,7 @@ struct CaseSettings {
   bool other_rig = false;
   // A rig key to state wrong (supply_pressure 15-30 % off, load_stiffness 40-80 % off, either
   // direction; a rig without a spring is drawn again for the latter).
-  std::string misstate;
+  std::string misstate = "";
   // The effects appear inside the capture, at 20-80 % of its length (Scenario::change).
   bool onset = false;
 };
