@@ -43,6 +43,9 @@ class Rig {
   const Plant& plant() const { return plant_; }
 
  private:
+  // The plant's and transducers' effects, with the integration step they need.
+  void use_effects(const Effects& effects) noexcept;
+
   Scenario scenario_;
   double period_;
   ProgramReference reference_;
@@ -51,6 +54,7 @@ class Rig {
   Sensors sensors_;
   SensorFaults faults_;
   std::uint64_t index_ = 0;
+  bool changed_ = false;  // Scenario::change applied
 };
 
 }  // namespace leakmon::sim

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,14 @@
 
 namespace leakmon::sim {
 
+// Effects that appear inside a run (a friction changing, a transducer shifting, a bias
+// appearing): from t_s on the rig runs with `effects`, those present from the start included.
+// (A leak alone has its own onset_s.)
+struct EffectChange {
+  double t_s = 0.0;
+  Effects effects;
+};
+
 struct Scenario {
   std::string name = "healthy";
   std::string origin;  // "preset paper-fig13" or "scenario path/to/file.yaml", for metadata
@@ -38,6 +47,7 @@ struct Scenario {
   RigDescription rig;
   Parameters params;
   Effects effects;
+  std::optional<EffectChange> change;  // effects that appear inside the run
   SensorSettings sensors;
   // Oil temperature and supply set-point over time (MODEL.md "Drifting operating conditions");
   // empty: the stationary rig at 40 degC and ps.

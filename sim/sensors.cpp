@@ -37,6 +37,11 @@ Sensors::Sensors(const SensorSettings& settings, const Effects& effects, std::ui
       seed_(seed),
       random_(seed),
       aux_random_(stream_seed(seed, kAuxiliaryStream)) {
+  set_effects(effects);
+}
+
+void Sensors::set_effects(const Effects& effects) noexcept {
+  offset_p1_ = offset_p2_ = 0.0;
   if (effects.sensor_offset) {
     (effects.sensor_offset->channel == PressureChannel::p1 ? offset_p1_ : offset_p2_) =
         effects.sensor_offset->offset;

@@ -43,6 +43,8 @@ class Sensors {
  public:
   Sensors(const SensorSettings& settings, const Effects& effects, std::uint64_t seed);
   void reset();
+  // The transducer offsets of `effects` from now on (Scenario::change).
+  void set_effects(const Effects& effects) noexcept;
   // p1_transducer, p2_transducer: the pressures after any transducer lag (plant states).
   Measurement measure(double x, double p1_transducer, double p2_transducer) noexcept;
   // The optional transducers (supply pressure: the pressure chain; oil temperature: the RTD),

@@ -111,6 +111,16 @@ capture::Metadata capture_metadata(const Scenario& scenario) {
   for (const auto& effect : effects) {
     meta.emplace_back("effect", fmt::format("{} {}", effect.name, format_params(effect.params)));
   }
+  if (scenario.change) {
+    std::string appearing;
+    for (const auto& effect : scenario.change->effects.describe()) {
+      appearing += fmt::format("{}{} {}", appearing.empty() ? "" : "; ", effect.name,
+                               format_params(effect.params));
+    }
+    meta.emplace_back("effect_change",
+                      fmt::format("t_s={:g} effects {}", scenario.change->t_s,
+                                  appearing.empty() ? std::string("none") : appearing));
+  }
   // Listed only for another rig, so that the paper's captures read as before.
   if (!scenario.rig.nominal()) meta.emplace_back("rig", describe(scenario.rig));
   const std::string overrides = overridden_parameters(scenario.params);
