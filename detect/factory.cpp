@@ -223,9 +223,7 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
              // paper's valve's, scaled to this one (their rows below take a configured value as
              // it is).
              other_option<O>(
-                 "valve_coefficient", "", "",
-                 "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]; design_leak's and min_leak's "
-                 "defaults scale with it",
+                 "valve_coefficient", "", "", "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]",
                  [](O& o, const config::ConfigNode* node, const Option<O>& row) {
                    if (node != nullptr)
                      o.rig.Kv = node->get_double(row.key, o.rig.Kv, row.lo, row.hi);
@@ -252,16 +250,20 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
                               "a hop is at rest below this speed, as are its neighbours [m/s]",
                               [](O& o) -> double& { return o.rest_speed; }),
              number_option<O>("design_leak", 1e-16, 1e-8,
-                              "leak coefficient C_L the CUSUM is tuned for [m^3/(s Pa)]",
+                              "leak coefficient C_L the CUSUM is tuned for [m^3/(s Pa)]; the "
+                              "default is the paper's "
+                              "valve's, scaled by the rig's Kv / 3.39e-7",
                               [](O& o) -> double& { return o.design_leak; })} +
          false_alarm_options<O>() +
          std::vector<Option<O>>{
              number_option<O>("sizing_seconds", 1.0, kMaxOptionSeconds,
                               "memory of the leak size estimate without a change [s]",
                               [](O& o) -> double& { return o.sizing_seconds; }),
-             number_option<O>("min_leak", 0.0, 1e-8,
-                              "leak at 40 degC that is never an alarm [m^3/(s Pa)]",
-                              [](O& o) -> double& { return o.min_leak; })} +
+             number_option<O>(
+                 "min_leak", 0.0, 1e-8,
+                 "leak at 40 degC that is never an alarm [m^3/(s Pa)]; the default scales like "
+                 "design_leak's",
+                 [](O& o) -> double& { return o.min_leak; })} +
          drift_options<O>(1.0) +
          std::vector<Option<O>>{other_option<O>(
              "estimate_supply", "", "true, false",
