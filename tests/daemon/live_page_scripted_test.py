@@ -92,7 +92,7 @@ def daemon_answers(leakmon, workdir):
                 series = trend["actuators"][0]["trend"]
                 finite = [v for v in series["index_p1"] if v is not None]
                 return trend if len(finite) >= 3 and newest_finite(series["p1"]) else None
-            trend = wait_for("three trend points with an index", trend_with_index, 30)
+            trend = wait_for("three trend points with an index", trend_with_index, 90)
             events = json.loads(http_get(base + "/api/events?after=0")[0])
             assets = {path: http_get(base + path) for path in ASSETS}
         finally:
