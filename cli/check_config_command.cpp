@@ -4,7 +4,7 @@
 
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "daemon/config.hpp"
+#include "pipeline/config.hpp"
 
 namespace leakmon::cli {
 

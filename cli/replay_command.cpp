@@ -1,5 +1,5 @@
 // `leakmon replay --in CAPTURE.csv --events EVENTS.jsonl [--config CONFIG.yaml] [--realtime]`
-// (FORMATS.md): a capture through the daemon's pipeline (daemon/replay.hpp).
+// (FORMATS.md): a capture through the daemon's pipeline (pipeline/replay.hpp).
 #include <fmt/format.h>
 
 #include <fstream>
@@ -7,9 +7,9 @@
 #include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "daemon/config.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/replay.hpp"
+#include "pipeline/config.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/replay.hpp"
 
 namespace leakmon::cli {
 

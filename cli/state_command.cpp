@@ -1,5 +1,5 @@
 // `leakmon state show|reset|learn` and `leakmon learn`: what the daemon keeps across restarts
-// in its state directory (daemon/state_store.hpp, docs/daemon.md "Restarts").
+// in its state directory (pipeline/state_store.hpp, docs/daemon.md "Restarts").
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
@@ -12,9 +12,9 @@
 #include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "daemon/config.hpp"
-#include "daemon/replay.hpp"
-#include "daemon/state_store.hpp"
+#include "pipeline/config.hpp"
+#include "pipeline/replay.hpp"
+#include "pipeline/state_store.hpp"
 
 namespace leakmon::cli {
 namespace {

@@ -5,9 +5,9 @@
 
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "daemon/config.hpp"
-#include "daemon/http_endpoint.hpp"
-#include "daemon/status_json.hpp"
+#include "pipeline/config.hpp"
+#include "http/http_endpoint.hpp"
+#include "views/status_json.hpp"
 
 namespace leakmon::cli {
 namespace {

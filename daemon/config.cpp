@@ -1,4 +1,4 @@
-#include "daemon/config.hpp"
+#include "pipeline/config.hpp"
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
@@ -19,7 +19,7 @@
 
 #include "daemon/driver_registry.hpp"
 #include "daemon/output_registry.hpp"
-#include "daemon/sample.hpp"
+#include "realtime/sample.hpp"
 #include "detect/factory.hpp"
 
 namespace leakmon::daemon {

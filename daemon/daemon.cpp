@@ -13,8 +13,8 @@
 
 #include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/http_router.hpp"
+#include "pipeline/event_log.hpp"
+#include "http/http_router.hpp"
 #include "daemon/output_registry.hpp"
 
 namespace leakmon::daemon {
@@ -476,7 +476,7 @@ int Daemon::run(double duration_s) {
   return 0;
 }
 
-// One route per line: the path, its method, and what serves it (daemon/http_router.hpp answers
+// One route per line: the path, its method, and what serves it (http/http_router.hpp answers
 // 405 with Allow for another method on a known path, 404 for the rest).
 HttpResponse Daemon::handle(const HttpRequest& request) {
   if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
@@ -500,7 +500,7 @@ HttpResponse Daemon::status(const HttpRequest& request) const {
 }
 
 // POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME. Anything else
-// acknowledges nothing (daemon/http_router.hpp ack_selection()).
+// acknowledges nothing (http/http_router.hpp ack_selection()).
 HttpResponse Daemon::acknowledge(const HttpRequest& request) {
   const AckSelection selection = ack_selection(request);
   if (selection.error) return *selection.error;

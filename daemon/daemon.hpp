@@ -15,14 +15,14 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/acquisition_loop.hpp"
-#include "daemon/config.hpp"
-#include "daemon/cpu_latency_request.hpp"
-#include "daemon/http_endpoint.hpp"
-#include "daemon/operator_view.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "pipeline/config.hpp"
+#include "realtime/cpu_latency_request.hpp"
+#include "http/http_endpoint.hpp"
+#include "views/operator_view.hpp"
 #include "daemon/service_notifier.hpp"
-#include "daemon/state_store.hpp"
-#include "daemon/worker.hpp"
+#include "pipeline/state_store.hpp"
+#include "pipeline/worker.hpp"
 #include "io/driver.hpp"
 #include "io/event.hpp"
 
@@ -40,10 +40,10 @@ class Daemon {
   // Throws config::ConfigError / io::DriverError when the configuration cannot start.
   int run(double duration_s = 0);
 
-  // Prometheus text exposition of everything the daemon counts (daemon/metrics_text.cpp).
+  // Prometheus text exposition of everything the daemon counts (views/metrics_text.cpp).
   std::string metrics_text() const;
   // GET /status: the status as JSON, and the human summary made from it that `leakmon status`
-  // prints (daemon/status_json.cpp).
+  // prints (views/status_json.cpp).
   std::string status_json() const;
   std::string status_text() const;
 
@@ -82,7 +82,7 @@ class Daemon {
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   HttpResponse handle(const HttpRequest& request);
-  // The live page's sample of the status (daemon/operator_view.cpp).
+  // The live page's sample of the status (views/operator_view.cpp).
   void fill_view_snapshot(ViewSnapshot& out) const;
   HttpResponse acknowledge(const HttpRequest& request);
   HttpResponse status(const HttpRequest& request) const;

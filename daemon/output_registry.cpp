@@ -1,6 +1,6 @@
 #include "daemon/output_registry.hpp"
 
-#include "daemon/event_log.hpp"
+#include "pipeline/event_log.hpp"
 #include "io/modbus/modbus_output.hpp"
 #include "io/mqtt/mqtt_output.hpp"
 

@@ -37,7 +37,7 @@ enum class EventKind {
   // detects nothing until `protected_from`.
   relearning,
   // A pressure-only detector's rig: the hydraulic mode it sees a leak through hardly shows above
-  // the transducers' noise while it learns (daemon/mode_visibility.hpp), so no leak alarm can
+  // the transducers' noise while it learns (pipeline/mode_visibility.hpp), so no leak alarm can
   // come from it. Announced when learning ends and again after a restart.
   detection_blind,
 };
@@ -126,7 +126,7 @@ struct ActuatorReading {
   double score = kNoValue;
   double leak_lpm_per_mpa = kNoValue;  // at 40 degC when the oil temperature is known
   double leak_lpm_per_mpa_ci95 = kNoValue;
-  std::string alarm_state;  // normal, raised, ... (daemon/alarm.hpp)
+  std::string alarm_state;  // normal, raised, ... (pipeline/alarm.hpp)
   bool learning = true;
 };
 // Called from the output's own thread; takes the worker's lock briefly, never the real-time

@@ -15,7 +15,7 @@
 #include <thread>
 #include <utility>
 
-#include "daemon/replay.hpp"
+#include "pipeline/replay.hpp"
 #include "detect/factory.hpp"
 #include "sim/random.hpp"
 #include "sim/sensor_faults.hpp"

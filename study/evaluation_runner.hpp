@@ -10,7 +10,7 @@
 
 #include "capture/capture.hpp"
 #include "config/yaml_reader.hpp"
-#include "daemon/config.hpp"
+#include "pipeline/config.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
 

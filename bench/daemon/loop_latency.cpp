@@ -13,11 +13,11 @@
 #include <thread>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/acquisition_loop.hpp"
-#include "daemon/config.hpp"
-#include "daemon/cpu_latency_request.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "pipeline/config.hpp"
+#include "realtime/cpu_latency_request.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/worker.hpp"
 #include "io/sim/sim_driver.hpp"
 
 using namespace leakmon;

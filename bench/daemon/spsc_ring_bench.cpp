@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <thread>
 
-#include "daemon/sample.hpp"
-#include "daemon/spsc_ring.hpp"
+#include "realtime/sample.hpp"
+#include "realtime/spsc_ring.hpp"
 
 namespace {
 

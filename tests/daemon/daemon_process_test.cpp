@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "capture/capture.hpp"
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"

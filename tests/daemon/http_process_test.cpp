@@ -12,9 +12,9 @@
 #include <fstream>
 #include <string>
 
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "tests/daemon/daemon_process.hpp"
-#include "tests/daemon/raw_http.hpp"
+#include "tests/http/raw_http.hpp"
 
 namespace leakmon::daemon {
 namespace {

@@ -11,7 +11,7 @@
 #include <fstream>
 
 #include "capture/capture.hpp"
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"

@@ -13,7 +13,7 @@
 #include <string>
 #include <thread>
 
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "tests/daemon/daemon_process.hpp"
 
 namespace leakmon {

@@ -1,0 +1,149 @@
+// The daemon's configuration (schema: config/README.md), read from YAML with errors that name
+// file, line and column. Everything is validated when loaded, so that `check-config`, start-up
+// and SIGHUP reload reject the same mistakes before anything runs.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/paths.hpp"
+#include "config/yaml_reader.hpp"
+#include "pipeline/alarm.hpp"
+#include "detect/sensor_plausibility.hpp"
+#include "dsp/streaming_features.hpp"
+
+namespace leakmon::daemon {
+
+// A `drivers:` entry; the mapping is handed whole to the driver's factory.
+struct DriverConfig {
+  std::string name;
+  std::string type;
+  std::optional<config::ConfigNode> node;  // absent for drivers built in code (replay_capture)
+};
+
+// A `sampling:` group: one real-time thread, one ring buffer.
+struct GroupConfig {
+  std::string name = "main";
+  std::int64_t period_ns = 2'000'000;
+  std::vector<std::string> drivers;  // names from `drivers:`
+  int priority = 80;                 // SCHED_FIFO priority; 0 keeps normal scheduling
+  std::vector<int> cpus;             // CPU affinity; empty = any
+  std::size_t ring_capacity = 8192;  // samples (16 s at 500 Hz)
+};
+
+// Where one actuator signal comes from: `driver.channel`.
+struct ChannelRef {
+  std::string driver;
+  std::string channel;
+  std::optional<config::ConfigNode> where;  // the YAML scalar, for error locations
+  bool present() const { return !channel.empty(); }
+  std::string text() const { return driver.empty() ? channel : driver + "." + channel; }
+};
+
+struct ActuatorConfig {
+  std::string name;
+  // Signals by role; p1 is required, the others optional (MODEL.md names).
+  ChannelRef p1, p2, u, x, xref, ps, temp;
+  dsp::FeatureParams features;
+  std::string detector = "default";
+  std::optional<config::ConfigNode> detector_options;
+  // Thresholds left NaN take the detector's own.
+  AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
+  std::string alarm_name = "internal_leakage";
+  // The transducers behind p1, p2 and x, for their plausibility checks (`transducers:`);
+  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise.
+  detect::TransducerSpec p1_transducer = detect::TransducerSpec::pressure();
+  detect::TransducerSpec p2_transducer = detect::TransducerSpec::pressure();
+  detect::TransducerSpec x_transducer = detect::TransducerSpec::position();
+};
+
+struct RecordingConfig {
+  std::string directory;                    // empty: no recording
+  std::optional<config::ConfigNode> where;  // `recording.directory`, for error locations
+  double rotate_seconds = 3600.0;           // start a new file after this much source time
+  std::size_t keep_files = 24;              // oldest files beyond this are deleted; 0 keeps all
+  double flush_seconds = 1.0;
+};
+
+// Where what was learned is kept across restarts (state_store.hpp).
+struct StateConfig {
+  std::string directory;                    // empty: nothing is kept (every start learns afresh)
+  double save_seconds = 60.0;               // save at least this often, and at shutdown
+  std::optional<config::ConfigNode> where;  // `state.directory` when given
+};
+
+struct MetricsConfig {
+  std::string address = "127.0.0.1";        // an IPv4 address (names are not resolved)
+  int port = 9187;                          // 0 disables the metrics and control endpoint
+  std::optional<config::ConfigNode> where;  // `metrics.port` (else `metrics`) when given
+  // Required by POST /ack when set; check-config demands one for a non-loopback address.
+  std::string ack_token;
+  // The live page's in-memory trend (views/trend_history.hpp): how far back, how finely.
+  double trend_seconds = 4 * 3600.0;
+  double trend_interval_s = 1.0;
+};
+
+// 127.0.0.0/8, ::1 or localhost: reachable from this machine only.
+bool is_loopback_address(const std::string& address);
+
+struct DaemonConfig {
+  std::string source;  // file the configuration came from, for messages
+  std::vector<DriverConfig> drivers;
+  std::vector<GroupConfig> groups;
+  std::vector<ActuatorConfig> actuators;
+  std::string event_log;  // JSON-lines file; empty: none
+  std::optional<config::ConfigNode> event_log_where;
+  RecordingConfig recording;
+  StateConfig state{config::default_state_directory(), 60.0, std::nullopt};
+  MetricsConfig metrics;
+  std::vector<config::ConfigNode> outputs;
+  // Worker wake-up interval when the rings are empty [ns]: bounds the sample-to-event latency
+  // (target p99 < 1 ms) at the cost of 2000 cheap wake-ups a second.
+  std::int64_t worker_poll_ns = 500'000;
+  // SCHED_FIFO priority of the worker thread (below the loops'), so that decisions and alarm
+  // events keep their latency on a loaded machine; 0 keeps normal scheduling.
+  int worker_priority = 70;
+  // Longest CPU idle-state exit the daemon tolerates [us], requested through
+  // /dev/cpu_dma_latency while it runs (0: CPUs never sleep deeper than polling, as cyclictest
+  // asks); negative: no request, the power management stays as the system has it.
+  int cpu_wakeup_latency_us = 0;
+};
+
+// Parses and validates; throws config::ConfigError with `file:line:column: path: message`.
+// Does not construct drivers (check_config() does that too, without starting them).
+DaemonConfig parse_config(const config::ConfigNode& root);
+DaemonConfig load_config(const std::string& path);
+
+// What check_config() looks at on this machine besides the file itself.
+struct Preflight {
+  // Devices the drivers name: CAN interfaces exist, serial ports are character devices.
+  bool devices = true;
+  // The metrics address and port can be bound now (nothing else listens there). A running
+  // daemon's reload leaves this out: it holds the port itself.
+  bool port = true;
+};
+
+// Full validation, the one `leakmon check-config` and `leakmon run` (and SIGHUP) share, so that
+// systemd's ExecStartPre and the start never disagree: parse, build (not start) every driver,
+// output and detector so their own option checks run, check that every actuator channel
+// exists, that the event log, recording and state paths can be written, and what `preflight`
+// asks for. Throws ConfigError with `file:line:column: message`.
+DaemonConfig check_config(const std::string& path, const Preflight& preflight = {});
+
+// The machine-dependent part of check_config() on a parsed configuration. Throws ConfigError.
+void check_paths(const DaemonConfig& config);
+void check_port(const DaemonConfig& config);
+void check_devices(const DaemonConfig& config);
+
+// Checks actuator channel references and group sizes against the channels the built drivers
+// offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.
+void check_channels(const DaemonConfig& config,
+                    const std::vector<std::vector<std::string>>& driver_channels);
+
+// The group that holds `driver`, or nullptr.
+const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);
+
+}  // namespace leakmon::daemon
