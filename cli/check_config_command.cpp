@@ -4,7 +4,7 @@
 
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 
 namespace leakmon::cli {
 

@@ -7,7 +7,7 @@
 #include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 #include "pipeline/event_log.hpp"
 #include "pipeline/replay.hpp"
 
@@ -30,12 +30,12 @@ int run_replay(int argc, char** argv) {
 
   auto capture = std::make_shared<const capture::Capture>(capture::read_capture(args.get("in")));
   const daemon::DaemonConfig config = args.get("config").empty()
-                                          ? daemon::default_replay_config(*capture)
+                                          ? pipeline::default_replay_config(*capture)
                                           : daemon::load_config(args.get("config"));
-  daemon::ReplayOptions options;
+  pipeline::ReplayOptions options;
   options.realtime = args.flag_set("realtime");
   options.state_directory = args.get("state-dir");
-  const auto result = daemon::replay_capture(capture, config, options);
+  const auto result = pipeline::replay_capture(capture, config, options);
 
   std::ofstream out(args.get("events"));
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.get("events")));

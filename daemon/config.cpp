@@ -1,4 +1,4 @@
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
@@ -43,10 +43,10 @@ std::string checked_name(const config::ConfigNode& node, std::set<std::string>& 
   return name;
 }
 
-ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig& config) {
+pipeline::ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig& config) {
   const std::string text = node.as_string();
   const auto dot = text.find('.');
-  ChannelRef ref;
+  pipeline::ChannelRef ref;
   ref.where = node;
   if (dot == std::string::npos) {
     if (config.drivers.size() != 1) {
@@ -62,8 +62,9 @@ ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig&
     ref.channel = text.substr(dot + 1);
   }
   if (ref.channel.empty()) node.fail(fmt::format("'{}': empty channel name", text));
-  const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
-                                 [&](const DriverConfig& d) { return d.name == ref.driver; });
+  const bool known =
+      std::any_of(config.drivers.begin(), config.drivers.end(),
+                  [&](const pipeline::DriverConfig& d) { return d.name == ref.driver; });
   if (!known) node.fail(fmt::format("'{}': no driver named '{}'", text, ref.driver));
   return ref;
 }
@@ -92,9 +93,9 @@ dsp::FeatureParams parse_features(const config::ConfigNode& node) {
   return params;
 }
 
-AlarmSettings parse_alarm(const config::ConfigNode& node) {
+pipeline::AlarmSettings parse_alarm(const config::ConfigNode& node) {
   node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching"});
-  AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
+  pipeline::AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   if (node.has("raise")) alarm.raise_threshold = node.get_double("raise", -1e9, 1e9);
   if (node.has("clear")) alarm.clear_threshold = node.get_double("clear", -1e9, 1e9);
   if (!std::isnan(alarm.raise_threshold) && !std::isnan(alarm.clear_threshold) &&
@@ -142,10 +143,10 @@ detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
   return spec;
 }
 
-ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
-                              std::set<std::string>& names) {
+pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
+                                        std::set<std::string>& names) {
   node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers"});
-  ActuatorConfig actuator;
+  pipeline::ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
   channels.expect_keys({"p1", "p2", "u", "x", "xref", "ps", "temp"});
@@ -156,10 +157,10 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
     if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
   }
   // One actuator's signals must be sampled together (one group, one clock).
-  const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
+  const pipeline::GroupConfig* group = pipeline::group_of_driver(config, actuator.p1.driver);
   for (const auto* ref :
        {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref, &actuator.ps, &actuator.temp}) {
-    if (ref->present() && group_of_driver(config, ref->driver) != group) {
+    if (ref->present() && pipeline::group_of_driver(config, ref->driver) != group) {
       channels.fail(
           fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
                       "actuator's channels must come from one sampling group",
@@ -196,10 +197,10 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   return actuator;
 }
 
-GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& config,
-                        std::set<std::string>& names, std::set<std::string>& grouped) {
+pipeline::GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& config,
+                                  std::set<std::string>& names, std::set<std::string>& grouped) {
   node.expect_keys({"name", "period_ms", "drivers", "priority", "cpus", "ring_capacity"});
-  GroupConfig group;
+  pipeline::GroupConfig group;
   group.name = checked_name(node, names, "sampling group");
   group.period_ns = static_cast<std::int64_t>(
       std::llround(node.get_double("period_ms", 2.0, 0.05, 10000.0) * 1e6));
@@ -215,7 +216,7 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
   for (const auto& item : node.at("drivers").items()) {
     const std::string name = item.as_string();
     const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
-                                   [&](const DriverConfig& d) { return d.name == name; });
+                                   [&](const pipeline::DriverConfig& d) { return d.name == name; });
     if (!known) item.fail(fmt::format("no driver named '{}'", name));
     if (!grouped.insert(name).second) {
       item.fail(fmt::format("driver '{}' is already in another sampling group", name));
@@ -228,15 +229,6 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
 
 }  // namespace
 
-const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver) {
-  for (const auto& group : config.groups) {
-    if (std::find(group.drivers.begin(), group.drivers.end(), driver) != group.drivers.end()) {
-      return &group;
-    }
-  }
-  return nullptr;
-}
-
 using config::resolve_path;
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
@@ -248,7 +240,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
   std::set<std::string> driver_names;
   const auto drivers = root.at("drivers");
   for (const auto& node : drivers.items()) {
-    DriverConfig driver;
+    pipeline::DriverConfig driver;
     driver.name = checked_name(node, driver_names, "driver");
     driver.type = node.get_string("type");
     driver.node = node;
@@ -267,7 +259,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
       }
     }
   } else {
-    GroupConfig group;
+    pipeline::GroupConfig group;
     for (const auto& driver : config.drivers) group.drivers.push_back(driver.name);
     config.groups.push_back(group);
   }
@@ -374,9 +366,10 @@ void check_channels(const DaemonConfig& config,
   for (const auto& group : config.groups) {
     std::size_t count = 0;
     for (const auto& driver : group.drivers) count += channels_of(driver).size();
-    if (count > kMaxGroupChannels) {
+    if (count > realtime::kMaxGroupChannels) {
       throw config::ConfigError(fmt::format("{}: sampling group '{}' has {} channels; at most {}",
-                                            config.source, group.name, count, kMaxGroupChannels));
+                                            config.source, group.name, count,
+                                            realtime::kMaxGroupChannels));
     }
   }
   for (const auto& actuator : config.actuators) {
@@ -391,7 +384,7 @@ void check_channels(const DaemonConfig& config,
       throw config::ConfigError(fmt::format("{}: {}", config.source, message));
     }
     // Build the detector once so that its options and signal needs are checked now.
-    const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
+    const pipeline::GroupConfig* group = pipeline::group_of_driver(config, actuator.p1.driver);
     detect::AvailableSignals signals;
     signals.p1 = true;
     signals.p2 = actuator.p2.present();

@@ -68,8 +68,9 @@ Daemon::~Daemon() { stop(); }
 
 std::vector<std::unique_ptr<io::EventSink>> Daemon::build_sinks(const DaemonConfig& config) const {
   std::vector<std::unique_ptr<io::EventSink>> sinks;
-  sinks.push_back(std::make_unique<LogEventSink>());
-  if (!config.event_log.empty()) sinks.push_back(std::make_unique<JsonlEventLog>(config.event_log));
+  sinks.push_back(std::make_unique<pipeline::LogEventSink>());
+  if (!config.event_log.empty())
+    sinks.push_back(std::make_unique<pipeline::JsonlEventLog>(config.event_log));
   for (const auto& node : config.outputs) sinks.push_back(make_output(node));
   if (operator_view_) sinks.push_back(operator_view_->event_sink());  // the page's last events
   return sinks;
@@ -85,7 +86,7 @@ void Daemon::attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& 
                              bool attach) const {
   io::ReadingSource source;
   if (attach) {
-    const Worker* worker = worker_.get();
+    const pipeline::Worker* worker = worker_.get();
     source = [worker] {
       std::vector<io::ActuatorReading> readings;
       for (const auto& a : worker->status()) {
@@ -113,11 +114,11 @@ void Daemon::start() {
   pthread_attr_setstacksize(&attr, kThreadStackBytes);
   pthread_setattr_default_np(&attr);
   pthread_attr_destroy(&attr);
-  if (const std::string warning = lock_process_memory(); !warning.empty()) {
+  if (const std::string warning = realtime::lock_process_memory(); !warning.empty()) {
     spdlog::warn("{}", warning);
   }
   if (config_.cpu_wakeup_latency_us >= 0) {
-    cpu_latency_ = CpuLatencyRequest(config_.cpu_wakeup_latency_us);
+    cpu_latency_ = realtime::CpuLatencyRequest(config_.cpu_wakeup_latency_us);
     if (!cpu_latency_.held()) spdlog::warn("{}", cpu_latency_.warning());
   }
 
@@ -126,45 +127,46 @@ void Daemon::start() {
     drivers_.back()->start();
     driver_watch_.emplace_back();
   }
-  std::vector<GroupInput> inputs;
+  std::vector<pipeline::GroupInput> inputs;
   for (const auto& group_config : config_.groups) {
     auto group = std::make_unique<Group>();
     group->config = group_config;
-    std::vector<ChannelRef> channels;
+    std::vector<pipeline::ChannelRef> channels;
     for (const auto& name : group_config.drivers) {
       for (std::size_t i = 0; i < config_.drivers.size(); ++i) {
         if (config_.drivers[i].name != name) continue;
         group->drivers.push_back(drivers_[i].get());
         for (const auto& channel : drivers_[i]->channels()) {
-          channels.push_back(ChannelRef{name, channel, std::nullopt});
+          channels.push_back(pipeline::ChannelRef{name, channel, std::nullopt});
         }
       }
     }
-    group->ring = std::make_unique<SpscRing<Sample>>(group_config.ring_capacity);
-    group->loop =
-        std::make_unique<AcquisitionLoop>(group_config.period_ns, group->drivers, *group->ring);
-    inputs.push_back(
-        GroupInput{group_config.name, group->ring.get(), channels, group_config.period_ns});
+    group->ring =
+        std::make_unique<realtime::SpscRing<realtime::Sample>>(group_config.ring_capacity);
+    group->loop = std::make_unique<realtime::AcquisitionLoop>(group_config.period_ns,
+                                                              group->drivers, *group->ring);
+    inputs.push_back(pipeline::GroupInput{group_config.name, group->ring.get(), channels,
+                                          group_config.period_ns});
     groups_.push_back(std::move(group));
   }
   reported_overruns_.assign(groups_.size(), 0);
   if (config_.metrics.port != 0) {
     std::vector<std::string> group_names;
     for (const auto& group : groups_) group_names.push_back(group->config.name);
-    operator_view_ = std::make_unique<OperatorView>(config_, group_names);
+    operator_view_ = std::make_unique<views::OperatorView>(config_, group_names);
     // The page shows what happened before a restart, starting with the log's newest events.
     if (!config_.event_log.empty()) operator_view_->restore_events(config_.event_log);
   }
   sinks_ = build_sinks(config_);
-  worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
+  worker_ = std::make_unique<pipeline::Worker>(config_, inputs, raw(sinks_));
   attach_readings(sinks_, true);
   // What was learned before a restart comes back before the first sample is acquired.
   if (!config_.state.directory.empty()) {
-    state_store_ = std::make_unique<StateStore>(config_.state.directory);
+    state_store_ = std::make_unique<pipeline::StateStore>(config_.state.directory);
     worker_->restore_states(*state_store_);
     // A file that fits the configuration is what the detector resumed from: its age is the
     // learned state's until the next save.
-    const auto fingerprints = state_fingerprints(config_);
+    const auto fingerprints = pipeline::state_fingerprints(config_);
     const auto listing = state_store_->list();
     const std::lock_guard lock(state_saved_mutex_);
     for (const auto& state : listing.states) {
@@ -199,10 +201,10 @@ void Daemon::start() {
   std::atomic<bool> worker_ready{false};
   worker_thread_ = std::thread([this, &worker_warnings, &worker_ready] {
     const std::int64_t poll_ns = config_.worker_poll_ns;
-    worker_warnings = make_thread_realtime(config_.worker_priority, {}).warnings;
+    worker_warnings = realtime::make_thread_realtime(config_.worker_priority, {}).warnings;
     worker_ready.store(true, std::memory_order_release);
     while (!stop_worker_.load(std::memory_order_acquire)) {
-      if (worker_->drain(monotonic_now_ns()) == 0) {
+      if (worker_->drain(realtime::monotonic_now_ns()) == 0) {
         std::this_thread::sleep_for(std::chrono::nanoseconds(poll_ns));
       }
     }
@@ -210,7 +212,7 @@ void Daemon::start() {
   for (auto& group : groups_) {
     Group* g = group.get();
     g->thread = std::thread([this, g] {
-      g->realtime = make_thread_realtime(g->config.priority, g->config.cpus);
+      g->realtime = realtime::make_thread_realtime(g->config.priority, g->config.cpus);
       g->realtime_ready.store(true, std::memory_order_release);
       g->loop->run(stop_acquisition_);
     });
@@ -233,13 +235,13 @@ void Daemon::start() {
                                       : std::string("normal scheduling"));
   }
   if (config_.metrics.port != 0) {
-    endpoint_ = std::make_unique<HttpEndpoint>(
+    endpoint_ = std::make_unique<http::HttpEndpoint>(
         config_.metrics.address, config_.metrics.port,
-        [this](const HttpRequest& request) { return handle(request); }, HttpLimits{},
+        [this](const http::HttpRequest& request) { return handle(request); }, http::HttpLimits{},
         &http_counters_);
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
-    operator_view_->start_sampling([this](ViewSnapshot& out) { fill_view_snapshot(out); });
+    operator_view_->start_sampling([this](views::ViewSnapshot& out) { fill_view_snapshot(out); });
     spdlog::info("live page on http://{}:{}/ ({:.1f} MB of trend history)", config_.metrics.address,
                  endpoint_->port(), static_cast<double>(operator_view_->history_bytes()) / 1e6);
   }
@@ -247,7 +249,7 @@ void Daemon::start() {
   if (!config_.recording.directory.empty()) {
     spdlog::info("recording raw samples under {}", config_.recording.directory);
   }
-  started_ns_ = monotonic_now_ns();
+  started_ns_ = realtime::monotonic_now_ns();
   last_state_save_ns_ = started_ns_;
   last_trend_save_ns_ = started_ns_;
 }
@@ -286,7 +288,7 @@ void Daemon::stop() {
   for (auto& driver : drivers_) driver->stop();
   stop_worker_.store(true, std::memory_order_release);
   if (worker_thread_.joinable()) worker_thread_.join();
-  worker_->drain(monotonic_now_ns());  // whatever the loops pushed last
+  worker_->drain(realtime::monotonic_now_ns());  // whatever the loops pushed last
   save_state(true);
   {
     // The last event: everything the loops, the worker and the state saving had to say is
@@ -298,7 +300,7 @@ void Daemon::stop() {
     event.pid = static_cast<long long>(::getpid());
     event.reason = stop_reason_;
     if (started_ns_ > 0) {
-      event.uptime_s = static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9;
+      event.uptime_s = static_cast<double>(realtime::monotonic_now_ns() - started_ns_) / 1e9;
     }
     worker_->publish(event);
   }
@@ -459,13 +461,13 @@ int Daemon::run(double duration_s) {
       break;
     }
     if (signal == SIGHUP) reload();
-    housekeeping(monotonic_now_ns());
+    housekeeping(realtime::monotonic_now_ns());
     if (all_sources_ended()) {
       spdlog::info("every source has ended: stopping");
       stop_reason_ = "end_of_sources";
       break;
     }
-    if (deadline_ns > 0 && monotonic_now_ns() >= deadline_ns) {
+    if (deadline_ns > 0 && realtime::monotonic_now_ns() >= deadline_ns) {
       spdlog::info("--duration {} s reached: stopping", duration_s);
       stop_reason_ = "duration";
       break;
@@ -478,22 +480,22 @@ int Daemon::run(double duration_s) {
 
 // One route per line: the path, its method, and what serves it (http/http_router.hpp answers
 // 405 with Allow for another method on a known path, 404 for the rest).
-HttpResponse Daemon::handle(const HttpRequest& request) {
+http::HttpResponse Daemon::handle(const http::HttpRequest& request) {
   if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
-  const HttpRoute routes[] = {
-      {"/metrics", "GET", [this](const HttpRequest&) { return metrics_response(); }},
-      {"/status", "GET", [this](const HttpRequest& r) { return status(r); }},
-      {"/ack", "POST", [this](const HttpRequest& r) { return acknowledge(r); }},
+  const http::HttpRoute routes[] = {
+      {"/metrics", "GET", [this](const http::HttpRequest&) { return metrics_response(); }},
+      {"/status", "GET", [this](const http::HttpRequest& r) { return status(r); }},
+      {"/ack", "POST", [this](const http::HttpRequest& r) { return acknowledge(r); }},
   };
-  return route(routes, request);
+  return http::route(routes, request);
 }
 
-HttpResponse Daemon::metrics_response() const {
+http::HttpResponse Daemon::metrics_response() const {
   return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
 }
 
-HttpResponse Daemon::status(const HttpRequest& request) const {
-  const StatusFormat format = status_format(request);
+http::HttpResponse Daemon::status(const http::HttpRequest& request) const {
+  const http::StatusFormat format = http::status_format(request);
   if (format.error) return *format.error;
   if (format.text) return {200, "text/plain; charset=utf-8", status_text()};
   return {200, "application/json", status_json()};
@@ -501,8 +503,8 @@ HttpResponse Daemon::status(const HttpRequest& request) const {
 
 // POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME. Anything else
 // acknowledges nothing (http/http_router.hpp ack_selection()).
-HttpResponse Daemon::acknowledge(const HttpRequest& request) {
-  const AckSelection selection = ack_selection(request);
+http::HttpResponse Daemon::acknowledge(const http::HttpRequest& request) {
+  const http::AckSelection selection = http::ack_selection(request);
   if (selection.error) return *selection.error;
   const std::size_t matched = worker_->acknowledge(selection.actuator);
   if (matched == 0) {

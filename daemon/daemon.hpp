@@ -15,16 +15,16 @@
 #include <thread>
 #include <vector>
 
-#include "realtime/acquisition_loop.hpp"
-#include "pipeline/config.hpp"
-#include "realtime/cpu_latency_request.hpp"
-#include "http/http_endpoint.hpp"
-#include "views/operator_view.hpp"
+#include "daemon/config.hpp"
 #include "daemon/service_notifier.hpp"
-#include "pipeline/state_store.hpp"
-#include "pipeline/worker.hpp"
+#include "http/http_endpoint.hpp"
 #include "io/driver.hpp"
 #include "io/event.hpp"
+#include "pipeline/state_store.hpp"
+#include "pipeline/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "realtime/cpu_latency_request.hpp"
+#include "views/operator_view.hpp"
 
 namespace leakmon::daemon {
 
@@ -49,12 +49,12 @@ class Daemon {
 
  private:
   struct Group {
-    GroupConfig config;
+    pipeline::GroupConfig config;
     std::vector<io::Driver*> drivers;
-    std::unique_ptr<SpscRing<Sample>> ring;
-    std::unique_ptr<AcquisitionLoop> loop;
+    std::unique_ptr<realtime::SpscRing<realtime::Sample>> ring;
+    std::unique_ptr<realtime::AcquisitionLoop> loop;
     std::thread thread;
-    RealtimeReport realtime;
+    realtime::RealtimeReport realtime;
     std::atomic<bool> realtime_ready{false};
   };
   // The driver health last reported in an event (main thread only).
@@ -81,12 +81,12 @@ class Daemon {
   std::map<std::string, double> state_saved_unix() const;
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
-  HttpResponse handle(const HttpRequest& request);
+  http::HttpResponse handle(const http::HttpRequest& request);
   // The live page's sample of the status (views/operator_view.cpp).
-  void fill_view_snapshot(ViewSnapshot& out) const;
-  HttpResponse acknowledge(const HttpRequest& request);
-  HttpResponse status(const HttpRequest& request) const;
-  HttpResponse metrics_response() const;
+  void fill_view_snapshot(views::ViewSnapshot& out) const;
+  http::HttpResponse acknowledge(const http::HttpRequest& request);
+  http::HttpResponse status(const http::HttpRequest& request) const;
+  http::HttpResponse metrics_response() const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -94,18 +94,18 @@ class Daemon {
   std::vector<std::unique_ptr<Group>> groups_;
   std::vector<std::unique_ptr<io::EventSink>> sinks_;
   mutable std::mutex sinks_mutex_;  // a reload swaps sinks_ while /metrics reads them
-  std::unique_ptr<Worker> worker_;
+  std::unique_ptr<pipeline::Worker> worker_;
   std::thread worker_thread_;
-  std::unique_ptr<OperatorView> operator_view_;  // the live page; null without an endpoint
-  HttpCounters http_counters_;                   // before endpoint_: the endpoint counts into it
-  std::unique_ptr<HttpEndpoint> endpoint_;
-  std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
+  std::unique_ptr<views::OperatorView> operator_view_;  // the live page; null without an endpoint
+  http::HttpCounters http_counters_;  // before endpoint_: the endpoint counts into it
+  std::unique_ptr<http::HttpEndpoint> endpoint_;
+  std::unique_ptr<pipeline::StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;
   std::int64_t last_trend_save_ns_ = 0;
   static constexpr double kTrendSaveSeconds = 600.0;
   mutable std::mutex state_saved_mutex_;  // the main thread saves, the metrics thread reads
   std::map<std::string, double> state_saved_unix_;
-  CpuLatencyRequest cpu_latency_;
+  realtime::CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};
   std::atomic<bool> stop_worker_{false};

@@ -8,7 +8,7 @@ namespace leakmon::daemon {
 namespace {
 
 constexpr OutputType kOutputTypes[] = {
-    {"jsonl", make_jsonl_output},
+    {"jsonl", pipeline::make_jsonl_output},
     {"modbus", io::make_modbus_output},
     {"mqtt", io::mqtt::make_mqtt_output},
 };

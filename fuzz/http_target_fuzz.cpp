@@ -10,7 +10,7 @@
 
 #include "http/http_target.hpp"
 
-using namespace leakmon::daemon;
+using namespace leakmon::http;
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 namespace {
 
 std::int64_t steady_now_ns() {
@@ -316,4 +316,4 @@ HttpResponse http_request(const std::string& address, int port, const std::strin
   return response;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

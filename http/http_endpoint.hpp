@@ -26,7 +26,7 @@
 
 struct MHD_Daemon;
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 
 struct HttpRequest {
   std::string method;                   // "GET", "HEAD", "POST", ...
@@ -120,4 +120,4 @@ HttpResponse http_request(const std::string& address, int port, const std::strin
 // `text` with every byte outside RFC 3986's unreserved set as %XX, for a query value.
 std::string percent_encode(std::string_view text);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 namespace {
 
 HttpResponse error(int status, std::string body) {
@@ -100,4 +100,4 @@ StatusFormat status_format(const HttpRequest& request) {
   return format;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

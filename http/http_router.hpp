@@ -10,7 +10,7 @@
 
 #include "http/http_endpoint.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 
 struct HttpRoute {
   std::string_view path;
@@ -39,4 +39,4 @@ struct StatusFormat {
 };
 StatusFormat status_format(const HttpRequest& request);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

@@ -1,6 +1,6 @@
 #include "http/http_target.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 namespace {
 
 int hex_value(char c) {
@@ -81,4 +81,4 @@ RequestTargetResult parse_request_target(std::string_view target) {
   return result;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

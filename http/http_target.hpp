@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 
 struct QueryParam {
   std::string name;        // decoded
@@ -38,4 +38,4 @@ std::optional<std::string> percent_decode(std::string_view text, bool plus_is_sp
 // further `=`. Fragments (`#`) never belong in a request and are an error.
 RequestTargetResult parse_request_target(std::string_view target);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

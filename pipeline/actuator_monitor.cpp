@@ -11,12 +11,12 @@
 #include "capture/units.hpp"
 #include "detect/factory.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double value_at(const Sample& sample, int index) {
+double value_at(const realtime::Sample& sample, int index) {
   return index < 0 ? kNaN : sample.values[static_cast<std::size_t>(index)];
 }
 
@@ -131,7 +131,7 @@ void ActuatorMonitor::note_relearning(std::uint64_t relearns, double protected_f
   protected_from_ = protected_from;
 }
 
-bool ActuatorMonitor::push(const Sample& sample, const EventPublisher& publish) {
+bool ActuatorMonitor::push(const realtime::Sample& sample, const EventPublisher& publish) {
   // Every checked channel releases its cleaned value of kDelay samples ago; u, xref and t wait
   // in delay_ for as long.
   constexpr std::size_t kDelay = detect::SensorPlausibility::kDelay;
@@ -298,7 +298,7 @@ void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPubl
 }
 
 void ActuatorMonitor::push_gap(double t, const EventPublisher& publish) {
-  Sample gap;
+  realtime::Sample gap;
   gap.t = t;
   gap.values.fill(kNaN);
   push(gap, publish);
@@ -477,4 +477,4 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   }
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

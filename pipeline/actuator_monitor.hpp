@@ -29,7 +29,7 @@
 #include "dsp/streaming_features.hpp"
 #include "io/event.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 // Where each role's value sits in a group's Sample; -1 when the actuator does not acquire it.
 struct ChannelLayout {
@@ -93,7 +93,7 @@ class ActuatorMonitor {
   const ChannelLayout& layout() const { return layout_; }
 
   // One sample of the actuator's group. Returns true when it completed a hop (a decision).
-  bool push(const Sample& sample, const EventPublisher& publish);
+  bool push(const realtime::Sample& sample, const EventPublisher& publish);
   // A sample that never arrived (missed cycle or ring drop) at source time t: a gap.
   void push_gap(double t, const EventPublisher& publish);
 
@@ -215,4 +215,4 @@ class ActuatorMonitor {
   std::uint64_t relearns_ = 0;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

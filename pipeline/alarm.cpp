@@ -1,6 +1,6 @@
 #include "pipeline/alarm.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 std::string_view to_string(AlarmState state) {
   switch (state) {
@@ -78,4 +78,4 @@ AlarmTransition Alarm::acknowledge() {
   return transition;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string_view>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 struct AlarmSettings {
   double raise_threshold = 1.0;  // score >= this counts towards raising
@@ -68,4 +68,4 @@ class Alarm {
   double below_since_ = NAN;  // first time of the current run of score <= clear
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <filesystem>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 namespace fs = std::filesystem;
 
@@ -50,7 +50,7 @@ void CaptureRecorder::prune() {
   }
 }
 
-void CaptureRecorder::record(const Sample& sample) {
+void CaptureRecorder::record(const realtime::Sample& sample) {
   if (!writer_ || sample.t - file_start_t_ >= config_.rotate_seconds) open(sample.t);
   row_[0] = sample.t;
   for (std::size_t i = 1; i < row_.size(); ++i) row_[i] = sample.values[i - 1];
@@ -75,4 +75,4 @@ void CaptureRecorder::close() {
   }
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -13,7 +13,7 @@
 #include "pipeline/config.hpp"
 #include "realtime/sample.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 class CaptureRecorder {
  public:
@@ -24,7 +24,7 @@ class CaptureRecorder {
   CaptureRecorder(const CaptureRecorder&) = delete;
   CaptureRecorder& operator=(const CaptureRecorder&) = delete;
 
-  void record(const Sample& sample);
+  void record(const realtime::Sample& sample);
   // Flushes when `flush_seconds` have passed since the last flush (monotonic ns).
   void maybe_flush(std::int64_t now_ns);
   void flush();
@@ -49,4 +49,4 @@ class CaptureRecorder {
   std::uint64_t rows_ = 0;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

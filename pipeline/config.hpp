@@ -1,6 +1,6 @@
-// The daemon's configuration (schema: config/README.md), read from YAML with errors that name
-// file, line and column. Everything is validated when loaded, so that `check-config`, start-up
-// and SIGHUP reload reject the same mistakes before anything runs.
+// The daemon's configuration as plain values (schema: config/README.md): what the pipeline is
+// built from. Reading it from YAML and checking it against the machine is the service's
+// (daemon/config.hpp).
 #pragma once
 
 #include <cstddef>
@@ -15,7 +15,7 @@
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 // A `drivers:` entry; the mapping is handed whole to the driver's factory.
 struct DriverConfig {
@@ -86,9 +86,6 @@ struct MetricsConfig {
   double trend_interval_s = 1.0;
 };
 
-// 127.0.0.0/8, ::1 or localhost: reachable from this machine only.
-bool is_loopback_address(const std::string& address);
-
 struct DaemonConfig {
   std::string source;  // file the configuration came from, for messages
   std::vector<DriverConfig> drivers;
@@ -112,38 +109,7 @@ struct DaemonConfig {
   int cpu_wakeup_latency_us = 0;
 };
 
-// Parses and validates; throws config::ConfigError with `file:line:column: path: message`.
-// Does not construct drivers (check_config() does that too, without starting them).
-DaemonConfig parse_config(const config::ConfigNode& root);
-DaemonConfig load_config(const std::string& path);
-
-// What check_config() looks at on this machine besides the file itself.
-struct Preflight {
-  // Devices the drivers name: CAN interfaces exist, serial ports are character devices.
-  bool devices = true;
-  // The metrics address and port can be bound now (nothing else listens there). A running
-  // daemon's reload leaves this out: it holds the port itself.
-  bool port = true;
-};
-
-// Full validation, the one `leakmon check-config` and `leakmon run` (and SIGHUP) share, so that
-// systemd's ExecStartPre and the start never disagree: parse, build (not start) every driver,
-// output and detector so their own option checks run, check that every actuator channel
-// exists, that the event log, recording and state paths can be written, and what `preflight`
-// asks for. Throws ConfigError with `file:line:column: message`.
-DaemonConfig check_config(const std::string& path, const Preflight& preflight = {});
-
-// The machine-dependent part of check_config() on a parsed configuration. Throws ConfigError.
-void check_paths(const DaemonConfig& config);
-void check_port(const DaemonConfig& config);
-void check_devices(const DaemonConfig& config);
-
-// Checks actuator channel references and group sizes against the channels the built drivers
-// offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.
-void check_channels(const DaemonConfig& config,
-                    const std::vector<std::vector<std::string>>& driver_channels);
-
 // The group that holds `driver`, or nullptr.
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -13,7 +13,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 std::string to_log_line(const io::Event& event) {
   std::string line(to_string(event.kind));
@@ -91,4 +91,4 @@ std::unique_ptr<io::EventSink> make_jsonl_output(const config::ConfigNode& node)
   }
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -11,7 +11,7 @@
 #include "io/event.hpp"
 #include "io/event_json.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 // The event log's JSON line (io/event_json.hpp, shared with the MQTT output).
 using io::to_json_line;
@@ -48,4 +48,4 @@ class CollectingEventSink final : public io::EventSink {
 // `outputs:` type jsonl: `{name, type: jsonl, path}` — a second event log, e.g. on a share.
 std::unique_ptr<io::EventSink> make_jsonl_output(const config::ConfigNode& node);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -29,7 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 class ModeVisibilityCheck {
  public:
@@ -85,4 +85,4 @@ class ModeVisibilityCheck {
   std::size_t count_ = 0;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

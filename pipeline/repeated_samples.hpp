@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <span>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 class RepeatedSampleCheck {
  public:
@@ -58,4 +58,4 @@ class RepeatedSampleCheck {
   bool repeating_ = false;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

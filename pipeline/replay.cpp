@@ -13,7 +13,7 @@
 #include "pipeline/worker.hpp"
 #include "io/replay/replay_driver.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr const char* kCaptureDriver = "capture";
@@ -95,8 +95,8 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
   io::ReplayDriver driver(settings, capture);
   driver.start();
 
-  SpscRing<Sample> ring(group.ring_capacity);
-  AcquisitionLoop loop(group.period_ns, {&driver}, ring);
+  realtime::SpscRing<realtime::Sample> ring(group.ring_capacity);
+  realtime::AcquisitionLoop loop(group.period_ns, {&driver}, ring);
 
   std::vector<ChannelRef> channels;
   for (const auto& name : driver.channels())
@@ -113,7 +113,7 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
     std::atomic<bool> stop{false};
     std::thread acquisition([&] { loop.run(stop); });
     while (!loop.counters().end_of_stream.load(std::memory_order_acquire)) {
-      worker.drain(monotonic_now_ns());
+      worker.drain(realtime::monotonic_now_ns());
       std::this_thread::sleep_for(std::chrono::nanoseconds(group.period_ns));
     }
     stop.store(true, std::memory_order_release);
@@ -149,4 +149,4 @@ ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
   return result;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

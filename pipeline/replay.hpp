@@ -14,7 +14,7 @@
 #include "pipeline/state_store.hpp"
 #include "io/event.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 struct ReplayOptions {
   // false: as fast as possible on a simulated clock (the loop waits for the worker instead of
@@ -49,4 +49,4 @@ ReplayResult replay_capture(const capture::Capture& capture, const DaemonConfig&
 ReplayResult replay_capture(std::shared_ptr<const capture::Capture> capture,
                             const DaemonConfig& config, const ReplayOptions& options = {});
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -16,7 +16,7 @@
 #include "detect/factory.hpp"
 #include "dsp/mode.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr std::string_view kMagic = "leakmon-state";
@@ -355,4 +355,4 @@ bool StateStore::remove(const std::string& actuator) const {
   return removed;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

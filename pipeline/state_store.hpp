@@ -20,7 +20,7 @@
 #include "pipeline/config.hpp"
 #include "detect/detector_state.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 // 2: the learning period's index over the noise floor (healthy_index_ratio), optional; version 1
 // files (without it) still load.
@@ -97,4 +97,4 @@ class StateStore {
   std::filesystem::path directory_;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -8,7 +8,7 @@
 
 #include "realtime/acquisition_loop.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<ChannelRef>& channels) {
   auto find = [&](const ChannelRef& ref) {
@@ -103,7 +103,7 @@ std::size_t Worker::drain(std::int64_t now_ns) {
   std::lock_guard lock(mutex_);
   std::size_t processed = 0;
   for (auto& group : groups_) {
-    while (Sample* sample = group.input.ring->front()) {
+    while (realtime::Sample* sample = group.input.ring->front()) {
       process(group, *sample, now_ns);
       group.input.ring->pop();
       ++processed;
@@ -114,7 +114,7 @@ std::size_t Worker::drain(std::int64_t now_ns) {
   return processed;
 }
 
-void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_ns) {
+void Worker::process(GroupState& group, const realtime::Sample& sample, std::int64_t now_ns) {
   const EventPublisher publish = [this](const io::Event& event) { publish_locked(event); };
   // Ticks that never arrived (missed cycles, ring drops) are gaps: they must invalidate the
   // windows that span them, not silently splice the signal together.
@@ -136,7 +136,7 @@ void Worker::process(GroupState& group, const Sample& sample, std::int64_t now_n
   bool decided = false;
   for (auto& monitor : group.monitors) decided |= monitor->push(sample, publish);
   if (decided && sample.monotonic_ns > 0) {
-    decision_latency_.record(monotonic_now_ns() - sample.monotonic_ns);
+    decision_latency_.record(realtime::monotonic_now_ns() - sample.monotonic_ns);
   }
   (void)now_ns;
 }
@@ -256,4 +256,4 @@ std::uint64_t Worker::events_published() const {
   return events_;
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -18,11 +18,11 @@
 #include "realtime/spsc_ring.hpp"
 #include "io/event.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 
 struct GroupInput {
   std::string name;
-  SpscRing<Sample>* ring = nullptr;
+  realtime::SpscRing<realtime::Sample>* ring = nullptr;
   std::vector<ChannelRef> channels;  // in Sample order
   std::int64_t period_ns = 2'000'000;
 };
@@ -62,7 +62,7 @@ class Worker {
   std::uint64_t samples_processed() const;
   std::uint64_t events_published() const;
   // From a sample's acquisition (monotonic) to the end of its decision and events.
-  const LatencyHistogram& decision_latency() const { return decision_latency_; }
+  const realtime::LatencyHistogram& decision_latency() const { return decision_latency_; }
 
  private:
   struct GroupState {
@@ -74,7 +74,7 @@ class Worker {
   };
   void build_monitors(const DaemonConfig& config, GroupState& group,
                       std::vector<std::unique_ptr<ActuatorMonitor>>* previous);
-  void process(GroupState& group, const Sample& sample, std::int64_t now_ns);
+  void process(GroupState& group, const realtime::Sample& sample, std::int64_t now_ns);
   void publish_locked(const io::Event& event);
 
   mutable std::mutex mutex_;
@@ -82,10 +82,10 @@ class Worker {
   std::vector<io::EventSink*> sinks_;
   std::uint64_t samples_ = 0;
   std::uint64_t events_ = 0;
-  LatencyHistogram decision_latency_;
+  realtime::LatencyHistogram decision_latency_;
 };
 
 // Where each role of `actuator` sits among `channels`.
 ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<ChannelRef>& channels);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -11,7 +11,7 @@
 #include <ctime>
 #include <stdexcept>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 namespace {
 
 constexpr std::int64_t kNsPerSecond = 1'000'000'000;
@@ -172,4 +172,4 @@ void AcquisitionLoop::run(const std::atomic<bool>& stop) noexcept {
   counters_.running.store(false, std::memory_order_release);
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

@@ -17,7 +17,7 @@
 #include "realtime/spsc_ring.hpp"
 #include "io/driver.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 struct LoopCounters {
   std::atomic<std::uint64_t> cycles{0};  // cycles run (ticks minus missed)
@@ -81,4 +81,4 @@ class AcquisitionLoop {
   LoopCounters counters_;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

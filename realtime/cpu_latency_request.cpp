@@ -8,7 +8,7 @@
 #include <cstring>
 #include <utility>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 CpuLatencyRequest::CpuLatencyRequest(std::int32_t max_wakeup_us, const std::string& device) {
   const int fd = ::open(device.c_str(), O_WRONLY | O_CLOEXEC);
@@ -46,4 +46,4 @@ CpuLatencyRequest::~CpuLatencyRequest() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 class CpuLatencyRequest {
  public:
@@ -32,4 +32,4 @@ class CpuLatencyRequest {
   std::string warning_;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

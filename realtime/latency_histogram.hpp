@@ -12,7 +12,7 @@
 #include <limits>
 #include <vector>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 class LatencyHistogram {
  public:
@@ -75,4 +75,4 @@ class LatencyHistogram {
   std::atomic<std::int64_t> max_ns_{0};
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

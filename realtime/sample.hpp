@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 // Channels per sampling group; a configuration with more is rejected when loaded.
 inline constexpr std::size_t kMaxGroupChannels = 32;
@@ -19,4 +19,4 @@ struct Sample {
   std::array<double, kMaxGroupChannels> values{};  // NaN marks a gap
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

@@ -38,7 +38,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 
 inline constexpr std::size_t kCacheLine = 64;
 
@@ -136,4 +136,4 @@ class SpscRing {
   alignas(kCacheLine) std::size_t cached_write_index_ = 0;  // consumer's copy of write_index_
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

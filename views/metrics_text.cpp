@@ -13,7 +13,7 @@
 #include "capture/units.hpp"
 #include "daemon/daemon.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 std::string escape_label_value(std::string_view text) {
   std::string out;
@@ -86,7 +86,7 @@ void PrometheusText::histogram(std::string_view name, std::string_view labels,
 namespace {
 
 void latency_histogram(PrometheusText& out, std::string_view name, std::string_view labels,
-                       const LatencyHistogram& h) {
+                       const realtime::LatencyHistogram& h) {
   static constexpr double kBucketsSeconds[] = {10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6,
                                                1e-3,  2e-3,  5e-3,  10e-3,  20e-3};
   std::uint64_t cumulative[std::size(kBucketsSeconds)];
@@ -104,7 +104,7 @@ std::uint64_t flag(bool on) { return on ? 1 : 0; }
 // actuator whose value is not finite gets no sample: the quantity does not exist there (no
 // temperature transducer, a detector that is not judged), which NaN would misstate.
 template <typename ValueOf>
-void per_actuator_gauge(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+void per_actuator_gauge(PrometheusText& out, std::span<const pipeline::ActuatorStatus> actuators,
                         std::string_view name, std::string_view help, ValueOf value,
                         bool skip_missing = false) {
   out.family(name, help, "gauge");
@@ -130,7 +130,7 @@ void state_set(PrometheusText& out, std::string_view name, std::string_view labe
   }
 }
 
-void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+void actuator_metrics(PrometheusText& out, std::span<const pipeline::ActuatorStatus> actuators,
                       const std::map<std::string, double>& state_saved_unix, double now_unix) {
   out.family("leakmon_index_pascal", "newest wavelet index (db8 level-2 detail RMS)", "gauge");
   for (const auto& a : actuators) {
@@ -148,11 +148,11 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   }
   per_actuator_gauge(out, actuators, "leakmon_detector_learning",
                      "1 while the detector learns the healthy baseline",
-                     [](const ActuatorStatus& a) { return flag(a.learning); });
+                     [](const pipeline::ActuatorStatus& a) { return flag(a.learning); });
   per_actuator_gauge(out, actuators, "leakmon_learning_remaining_seconds",
                      "source time until the detector decides (0: it decides; after a reload that "
                      "invalidated what it learned, until it has learned again)",
-                     [](const ActuatorStatus& a) { return a.learning_seconds_left; });
+                     [](const pipeline::ActuatorStatus& a) { return a.learning_seconds_left; });
   out.family("leakmon_relearn_total",
              "reloads that changed an option the learned state depends on (learning started over)",
              "counter");
@@ -164,22 +164,22 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
     out.sample("leakmon_alarm_active",
                label("actuator", a.name) + "," + label("alarm", a.alarm) + "," +
                    label("state", to_string(a.state)),
-               flag(a.state != AlarmState::normal));
+               flag(a.state != pipeline::AlarmState::normal));
   }
   // FORMATS.md "Operator view and fleet": the leak size in l/min/MPa (at 40 degC where the oil
   // temperature is acquired), NaN until the detector has one; its 95 % half-width beside it.
   per_actuator_gauge(
       out, actuators, "leakmon_leak_lpm_per_mpa",
       "estimated internal leakage [l/min/MPa], at 40 degC with a temp channel",
-      [](const ActuatorStatus& a) { return units::lpm_per_mpa(a.leak_coefficient); });
-  per_actuator_gauge(out, actuators, "leakmon_leak_lpm_per_mpa_ci95",
-                     "95 % half-width of the leak size [l/min/MPa]", [](const ActuatorStatus& a) {
-                       return units::lpm_per_mpa(a.leak_coefficient_ci);
-                     });
+      [](const pipeline::ActuatorStatus& a) { return units::lpm_per_mpa(a.leak_coefficient); });
+  per_actuator_gauge(
+      out, actuators, "leakmon_leak_lpm_per_mpa_ci95",
+      "95 % half-width of the leak size [l/min/MPa]",
+      [](const pipeline::ActuatorStatus& a) { return units::lpm_per_mpa(a.leak_coefficient_ci); });
   per_actuator_gauge(
       out, actuators, "leakmon_oil_temperature_celsius",
       "oil temperature (hop mean of the temp channel)",
-      [](const ActuatorStatus& a) { return a.oil_temperature; }, true);
+      [](const pipeline::ActuatorStatus& a) { return a.oil_temperature; }, true);
   out.family("leakmon_sensor_status", "NAMUR NE 107 status of each transducer channel (1: current)",
              "gauge");
   for (const auto& a : actuators) {
@@ -198,21 +198,21 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   }
   per_actuator_gauge(out, actuators, "leakmon_detector_suspended",
                      "1 while a faulty channel holds the leak decision",
-                     [](const ActuatorStatus& a) { return flag(a.suspended); });
+                     [](const pipeline::ActuatorStatus& a) { return flag(a.suspended); });
   per_actuator_gauge(
       out, actuators, "leakmon_acquisition_repeated_samples",
       "samples of the last second that repeat the one before exactly (100 of 500: the "
       "acquisition is slower than its sampling, and the leak decision is held)",
-      [](const ActuatorStatus& a) { return static_cast<double>(a.repeated_samples); });
+      [](const pipeline::ActuatorStatus& a) { return static_cast<double>(a.repeated_samples); });
   per_actuator_gauge(
       out, actuators, "leakmon_hydraulic_mode_visibility",
       "pressure-only detectors: median index while learning over the transducer's noise floor, "
       "best chamber (below 2.5 the rig is blind to a leak: detection_blind)",
-      [](const ActuatorStatus& a) { return a.mode_visibility; }, true);
+      [](const pipeline::ActuatorStatus& a) { return a.mode_visibility; }, true);
   per_actuator_gauge(out, actuators, "leakmon_detection_blind",
                      "1 when a pressure-only detector's rig showed no hydraulic mode to see a "
                      "leak by while it learned",
-                     [](const ActuatorStatus& a) { return flag(a.detection_blind); });
+                     [](const pipeline::ActuatorStatus& a) { return flag(a.detection_blind); });
   out.family("leakmon_learned_state_age_seconds",
              "seconds since the learned state kept in the state directory was saved", "gauge");
   for (const auto& a : actuators) {
@@ -224,6 +224,11 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
   }
 }
 
+}  // namespace leakmon::views
+
+// The service's side, until it fills a snapshot the views format.
+namespace leakmon::daemon {
+using namespace leakmon::views;
 std::string Daemon::metrics_text() const {
   PrometheusText out;
   out.family("leakmon_build_info", "leakmon version", "gauge");
@@ -342,5 +347,6 @@ std::string Daemon::metrics_text() const {
   out.sample("leakmon_http_connections", "", http_counters_.open_connections.load());
   return out.take();
 }
-
 }  // namespace leakmon::daemon
+
+namespace leakmon::views {}  // namespace leakmon::views

@@ -13,7 +13,7 @@
 #include "pipeline/actuator_monitor.hpp"
 #include "io/device_status.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 // A label value with `\`, `"` and newline escaped as the exposition format requires.
 std::string escape_label_value(std::string_view text);
@@ -58,7 +58,7 @@ void state_set(PrometheusText& out, std::string_view name, std::string_view labe
 // oil temperature, sensor status, learned state age). `state_saved_unix`: by actuator, the wall
 // time [s since 1970] the learned state kept in the state directory was saved (an actuator
 // without an entry has no saved state and gets no age sample); `now_unix` the present wall time.
-void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actuators,
+void actuator_metrics(PrometheusText& out, std::span<const pipeline::ActuatorStatus> actuators,
                       const std::map<std::string, double>& state_saved_unix, double now_unix);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

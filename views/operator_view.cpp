@@ -21,7 +21,7 @@
 #include "views/web_assets.hpp"
 #include "io/event_json.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 namespace {
 
 double unix_now() {
@@ -121,7 +121,7 @@ int hex_digit(char c) {
   return -1;
 }
 
-HttpResponse json_response(std::string body) {
+http::HttpResponse json_response(std::string body) {
   return {200, "application/json; charset=utf-8", std::move(body)};
 }
 
@@ -204,7 +204,7 @@ class RecentEventsSink final : public io::EventSink {
   std::shared_ptr<RecentEvents> events_;
 };
 
-std::vector<std::string> actuator_names(const DaemonConfig& config) {
+std::vector<std::string> actuator_names(const pipeline::DaemonConfig& config) {
   std::vector<std::string> names;
   for (const auto& a : config.actuators) names.push_back(a.name);
   return names;
@@ -212,7 +212,8 @@ std::vector<std::string> actuator_names(const DaemonConfig& config) {
 
 }  // namespace
 
-OperatorView::OperatorView(const DaemonConfig& config, const std::vector<std::string>& groups)
+OperatorView::OperatorView(const pipeline::DaemonConfig& config,
+                           const std::vector<std::string>& groups)
     : interval_s_(config.metrics.trend_interval_s),
       events_(std::make_shared<RecentEvents>(kRecentEvents)),
       history_(trend_capacity(config.metrics.trend_seconds, config.metrics.trend_interval_s),
@@ -270,7 +271,7 @@ void OperatorView::set_ack_token(const std::string& token) {
   ack_token_ = token;
 }
 
-void OperatorView::save_history(const StateStore& store) const {
+void OperatorView::save_history(const pipeline::StateStore& store) const {
   std::vector<std::pair<std::string, std::string>> files;
   {
     std::lock_guard lock(mutex_);
@@ -282,7 +283,8 @@ void OperatorView::save_history(const StateStore& store) const {
     store.write_atomically(store.trend_file_of(actuator), text);
 }
 
-std::vector<std::string> OperatorView::restore_history(const StateStore& store, double unix_now) {
+std::vector<std::string> OperatorView::restore_history(const pipeline::StateStore& store,
+                                                       double unix_now) {
   std::vector<std::string> warnings;
   const double oldest = unix_now - static_cast<double>(history_.capacity()) * interval_s_;
   std::vector<std::string> names;
@@ -482,7 +484,7 @@ std::string OperatorView::trend_json(double since) const {
   return out;
 }
 
-std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) const {
+std::optional<http::HttpResponse> OperatorView::handle(const http::HttpRequest& request) const {
   if (request.path == "/ack") {
     std::string token;
     {
@@ -497,9 +499,9 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
     if (token.empty() || bearer_ok || same_token(query_value(request.query, "token"), token)) {
       return std::nullopt;  // the daemon acknowledges
     }
-    return HttpResponse{401, "text/plain; charset=utf-8",
-                        "acknowledging needs the token of metrics.ack_token: POST "
-                        "/ack?actuator=NAME&token=TOKEN\n"};
+    return http::HttpResponse{401, "text/plain; charset=utf-8",
+                              "acknowledging needs the token of metrics.ack_token: POST "
+                              "/ack?actuator=NAME&token=TOKEN\n"};
   }
   if (request.method != "GET" && request.method != "HEAD") return std::nullopt;
   if (request.path == "/api/trend") {
@@ -507,8 +509,8 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
     char* end = nullptr;
     double value = since.empty() ? 0.0 : std::strtod(since.c_str(), &end);
     if (!since.empty() && (end == nullptr || *end != '\0' || !std::isfinite(value))) {
-      return HttpResponse{400, "text/plain; charset=utf-8",
-                          fmt::format("since: '{}' is not a unix time in seconds\n", since)};
+      return http::HttpResponse{400, "text/plain; charset=utf-8",
+                                fmt::format("since: '{}' is not a unix time in seconds\n", since)};
     }
     return json_response(trend_json(value));
   }
@@ -517,8 +519,8 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
     char* end = nullptr;
     const unsigned long long value = after.empty() ? 0 : std::strtoull(after.c_str(), &end, 10);
     if (!after.empty() && (end == nullptr || *end != '\0')) {
-      return HttpResponse{400, "text/plain; charset=utf-8",
-                          fmt::format("after: '{}' is not an event number\n", after)};
+      return http::HttpResponse{400, "text/plain; charset=utf-8",
+                                fmt::format("after: '{}' is not an event number\n", after)};
     }
     return json_response(events_->json_after(value));
   }
@@ -528,13 +530,13 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
   for (const auto& asset : web_assets()) {
     if (asset.path == path) {
       // The page's policy as a header too: the meta tag cannot forbid framing.
-      return HttpResponse{200,
-                          std::string(asset.content_type),
-                          std::string(asset.body),
-                          {{"Content-Security-Policy",
-                            "default-src 'none'; script-src 'self'; style-src 'self'; "
-                            "img-src 'self'; connect-src 'self'; frame-ancestors 'none'"},
-                           {"X-Content-Type-Options", "nosniff"}}};
+      return http::HttpResponse{200,
+                                std::string(asset.content_type),
+                                std::string(asset.body),
+                                {{"Content-Security-Policy",
+                                  "default-src 'none'; script-src 'self'; style-src 'self'; "
+                                  "img-src 'self'; connect-src 'self'; frame-ancestors 'none'"},
+                                 {"X-Content-Type-Options", "nosniff"}}};
     }
   }
   return std::nullopt;
@@ -542,6 +544,11 @@ std::optional<HttpResponse> OperatorView::handle(const HttpRequest& request) con
 
 // The daemon's side of the sampling: what /metrics reads, into `out` without allocating once
 // `out` has the daemon's shape (the groups are fixed; a reload may add actuators).
+}  // namespace leakmon::views
+
+// The service's side, until it fills a snapshot the views format.
+namespace leakmon::daemon {
+using namespace leakmon::views;
 void Daemon::fill_view_snapshot(ViewSnapshot& out) const {
   worker_->status_into(out.actuators);
   out.groups.resize(groups_.size());
@@ -554,5 +561,6 @@ void Daemon::fill_view_snapshot(ViewSnapshot& out) const {
   out.events = worker_->events_published();
   out.decision_latency_p99_ns = worker_->decision_latency().quantile_ns(0.99);
 }
-
 }  // namespace leakmon::daemon
+
+namespace leakmon::views {}  // namespace leakmon::views

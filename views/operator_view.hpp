@@ -26,7 +26,7 @@
 #include "views/trend_history.hpp"
 #include "io/event.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 // The last `capacity` events as JSON lines (event_log.hpp's to_json_line), numbered from 1.
 // Fed on the worker thread through event_sink(), read by the HTTP thread.
@@ -59,7 +59,7 @@ class OperatorView {
   static constexpr std::size_t kRecentEvents = 100;
 
   // Allocates the trend history for the configuration's actuators and `groups`.
-  OperatorView(const DaemonConfig& config, const std::vector<std::string>& groups);
+  OperatorView(const pipeline::DaemonConfig& config, const std::vector<std::string>& groups);
   ~OperatorView();
   OperatorView(const OperatorView&) = delete;
   OperatorView& operator=(const OperatorView&) = delete;
@@ -81,8 +81,8 @@ class OperatorView {
   // `store`'s directory (atomically, throws std::runtime_error naming the file);
   // restore_history() puts back the points of the last `trend_seconds` before `unix_now`, with
   // a gap where the daemon was down, and returns a warning for each file it set aside.
-  void save_history(const StateStore& store) const;
-  std::vector<std::string> restore_history(const StateStore& store, double unix_now);
+  void save_history(const pipeline::StateStore& store) const;
+  std::vector<std::string> restore_history(const pipeline::StateStore& store, double unix_now);
   // The newest events of the event log (a JSON-lines file, possibly being appended to by
   // nobody else) into the page's recent events; lines that are not whole JSON objects are
   // skipped. Returns how many were taken.
@@ -90,7 +90,7 @@ class OperatorView {
 
   // The page, its assets and its data; a 401 for /ack without the configured token; nullopt
   // for everything else (the daemon's own routes).
-  std::optional<HttpResponse> handle(const HttpRequest& request) const;
+  std::optional<http::HttpResponse> handle(const http::HttpRequest& request) const;
 
   // JSON of /api/trend: points after `since` (unix seconds) and the newest status.
   std::string trend_json(double since) const;
@@ -116,4 +116,4 @@ class OperatorView {
   std::thread sampler_;
 };
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

@@ -10,7 +10,7 @@
 #include "daemon/daemon.hpp"
 #include "io/event_json.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 namespace {
 
 using io::json_string;
@@ -23,8 +23,13 @@ std::string json_number(double value) {
   return std::isfinite(value) ? fmt::format("{}", value) : "null";
 }
 
+}  // namespace leakmon::views
+
+// The service's side, until it fills a snapshot the views format.
+namespace leakmon::daemon {
+using namespace leakmon::views;
 std::string Daemon::status_json() const {
-  const std::int64_t now = monotonic_now_ns();
+  const std::int64_t now = realtime::monotonic_now_ns();
   std::string out = "{";
   out += fmt::format("\"version\":{},\"uptime_s\":{},\"config\":{},", json_string(LEAKMON_VERSION),
                      json_number(static_cast<double>(now - started_ns_) / 1e9),
@@ -65,9 +70,9 @@ std::string Daemon::status_json() const {
   const auto actuators = worker_->status();
   for (std::size_t i = 0; i < actuators.size(); ++i) {
     const auto& a = actuators[i];
-    const char* state = a.state != AlarmState::normal ? "alarm"
-                        : a.learning                  ? "learning"
-                                                      : "monitoring";
+    const char* state = a.state != pipeline::AlarmState::normal ? "alarm"
+                        : a.learning                            ? "learning"
+                                                                : "monitoring";
     out += fmt::format(
         "{}{{\"name\":{},\"detector\":{},\"state\":\"{}\",\"learning_seconds_left\":{},"
         "\"t\":{},\"index_pa\":{{\"p1\":{},\"p2\":{}}},\"score\":{},\"threshold\":{{\"raise\":{},"
@@ -96,8 +101,11 @@ std::string Daemon::status_json() const {
   out += "]}\n";
   return out;
 }
+std::string Daemon::status_text() const { return views::status_text_from_json(status_json()); }
 
-std::string Daemon::status_text() const { return status_text_from_json(status_json()); }
+}  // namespace leakmon::daemon
+
+namespace leakmon::views {
 
 namespace {
 
@@ -210,4 +218,4 @@ std::string status_text_from_json(std::string_view json) {
   }
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 // A JSON number, or null for NaN and infinities (JSON has neither).
 std::string json_number(double value);
@@ -15,4 +15,4 @@ std::string json_number(double value);
 // one (names what is missing).
 std::string status_text_from_json(std::string_view json);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

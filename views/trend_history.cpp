@@ -13,12 +13,12 @@
 
 #include "capture/units.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-TrendPoint point_of(double unix_time, const ActuatorStatus& a) {
+TrendPoint point_of(double unix_time, const pipeline::ActuatorStatus& a) {
   TrendPoint p;
   p.unix_time = unix_time;
   p.index_p1 = a.index_p1;
@@ -175,8 +175,9 @@ std::vector<TrendPoint> decode_trend(std::string_view text) {
   return points;
 }
 
-void read_loop_health(LoopHealth& out, const std::string& group, const LoopCounters& counters,
-                      std::size_t ring_capacity, bool realtime) {
+void read_loop_health(LoopHealth& out, const std::string& group,
+                      const realtime::LoopCounters& counters, std::size_t ring_capacity,
+                      bool realtime) {
   out.group = group;
   out.realtime = realtime;
   out.cycles = counters.cycles.load(std::memory_order_relaxed);
@@ -273,4 +274,4 @@ std::size_t TrendHistory::memory_bytes() const {
   return memory_bytes(capacity_, actuators_.size(), groups_.size());
 }
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

@@ -16,7 +16,7 @@
 #include "realtime/acquisition_loop.hpp"
 #include "pipeline/actuator_monitor.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 // One sampling group's loop health as the page shows it.
 struct LoopHealth {
@@ -31,13 +31,14 @@ struct LoopHealth {
 
 // A group's health from its loop's counters, into `out` without allocating (the name is
 // assigned in place: the same name reuses its storage).
-void read_loop_health(LoopHealth& out, const std::string& group, const LoopCounters& counters,
-                      std::size_t ring_capacity, bool realtime);
+void read_loop_health(LoopHealth& out, const std::string& group,
+                      const realtime::LoopCounters& counters, std::size_t ring_capacity,
+                      bool realtime);
 
 // What the sampler reads each interval: the actuators' status (as /metrics reads it) and the
 // loops' health. Filled in place, so that a warm snapshot is refilled without allocating.
 struct ViewSnapshot {
-  std::vector<ActuatorStatus> actuators;
+  std::vector<pipeline::ActuatorStatus> actuators;
   std::vector<LoopHealth> groups;
   std::uint64_t samples_processed = 0;
   std::uint64_t events = 0;
@@ -145,4 +146,4 @@ std::vector<TrendPoint> decode_trend(std::string_view text);
 // Trend points kept for `seconds` of history at one point every `interval_s` (at least 2).
 std::size_t trend_capacity(double seconds, double interval_s);
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

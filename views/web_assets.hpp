@@ -5,7 +5,7 @@
 #include <span>
 #include <string_view>
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 
 struct WebAsset {
   std::string_view path;  // URL path, e.g. "/" or "/uplot.min.js"
@@ -15,4 +15,4 @@ struct WebAsset {
 
 std::span<const WebAsset> web_assets();
 
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

@@ -10,8 +10,8 @@
 
 namespace {
 
-using leakmon::daemon::Sample;
-using leakmon::daemon::SpscRing;
+using leakmon::realtime::Sample;
+using leakmon::realtime::SpscRing;
 
 template <typename T>
 void transfer(benchmark::State& state) {

@@ -1,6 +1,6 @@
 // Configuration errors an operator can act on: file:line:column and the field, for unknown
 // keys, wrong types, out-of-range values and references to things that do not exist.
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@
 #include "http/http_endpoint.hpp"
 #include "tests/http/raw_http.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 namespace {
 
 using namespace std::chrono_literals;
@@ -102,4 +102,4 @@ TEST(HttpEndpoint, DripFeedingClientIsCutOffByTheDeadline) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

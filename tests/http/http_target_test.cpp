@@ -10,7 +10,7 @@
 #include "views/status_json.hpp"
 #include "io/event_json.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::http {
 namespace {
 
 RequestTarget parsed(std::string_view text) {
@@ -146,9 +146,9 @@ TEST(StatusJson, StringsAreAlwaysValidJsonAndNumbersNeverNan) {
   EXPECT_EQ(json_string("\xc3\xa9"), "\"\xc3\xa9\"");
   EXPECT_EQ(json_string("x\xff\xc3"), "\"x\\ufffd\\ufffd\"");           // invalid, truncated
   EXPECT_EQ(json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"");  // a surrogate
-  EXPECT_EQ(json_number(NAN), "null");
-  EXPECT_EQ(json_number(INFINITY), "null");
-  EXPECT_EQ(json_number(1.5), "1.5");
+  EXPECT_EQ(views::json_number(NAN), "null");
+  EXPECT_EQ(views::json_number(INFINITY), "null");
+  EXPECT_EQ(views::json_number(1.5), "1.5");
 }
 
 // The human form from a document as the daemon writes it, with values not known yet.
@@ -165,15 +165,15 @@ TEST(StatusJson, HumanFormSaysWhatIsNotKnownInsteadOfNan) {
       R"("leak_lpm_per_mpa":{"estimate":null,"ci95":null},"oil_temperature_c":null,)"
       R"("alarms":[{"name":"internal_leakage","state":"normal"}],"suspended":false,)"
       R"("sensors":[{"channel":"p2","status":"ok","fault":null,"spikes_rejected":0}]}]})";
-  const std::string text = status_text_from_json(json);
+  const std::string text = views::status_text_from_json(json);
   EXPECT_EQ(text.find("nan"), std::string::npos) << text;
   EXPECT_NE(text.find("learning, 23 s left"), std::string::npos) << text;
   EXPECT_NE(text.find("p2 n/a"), std::string::npos) << text;
   EXPECT_NE(text.find("leak estimate n/a"), std::string::npos) << text;
   EXPECT_NE(text.find("channel p2: ok"), std::string::npos) << text;
-  EXPECT_THROW(status_text_from_json("not json {"), std::runtime_error);
-  EXPECT_THROW(status_text_from_json("{\"x\":1}"), std::runtime_error);
+  EXPECT_THROW(views::status_text_from_json("not json {"), std::runtime_error);
+  EXPECT_THROW(views::status_text_from_json("{\"x\":1}"), std::runtime_error);
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::http

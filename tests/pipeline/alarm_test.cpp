@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 AlarmSettings settings(double on_delay, double off_delay, bool latching) {
@@ -87,4 +87,4 @@ TEST(Alarm, LatchedAcknowledgedWhileActiveClearsOnReturn) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

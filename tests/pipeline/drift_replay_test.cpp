@@ -10,7 +10,7 @@
 #include "pipeline/replay.hpp"
 #include "sim/simulate.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kOnset = 700.0;
@@ -67,4 +67,4 @@ TEST(DriftReplay, WarmUpAndSupplyChangeAreNotALeakAndTheLeakAfterIsSizedAt40C) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

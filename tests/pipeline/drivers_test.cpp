@@ -74,16 +74,16 @@ TEST(ReplayDriver, LoopsWithTimeContinuing) {
 
 TEST(CaptureRecorder, RotatesAndReplaysToTheSameSamples) {
   const std::string dir = test::scratch_dir("capture_recorder_roundtrip");
-  daemon::RecordingConfig recording;
+  pipeline::RecordingConfig recording;
   recording.directory = dir;
   recording.rotate_seconds = 1.0;
   recording.keep_files = 0;
-  std::vector<daemon::Sample> written;
+  std::vector<realtime::Sample> written;
   std::vector<std::string> files;
   {
-    daemon::CaptureRecorder recorder("main", {"p1", "u"}, 500.0, recording);
+    pipeline::CaptureRecorder recorder("main", {"p1", "u"}, 500.0, recording);
     for (int i = 0; i < 1200; ++i) {
-      daemon::Sample s;
+      realtime::Sample s;
       s.tick = static_cast<std::uint64_t>(i);
       s.t = i * 0.002;
       s.channel_count = 2;
@@ -119,12 +119,12 @@ TEST(CaptureRecorder, RotatesAndReplaysToTheSameSamples) {
 
 TEST(CaptureRecorder, KeepsOnlyTheNewestFiles) {
   const std::string dir = test::scratch_dir("capture_recorder_keep");
-  daemon::RecordingConfig recording;
+  pipeline::RecordingConfig recording;
   recording.directory = dir;
   recording.rotate_seconds = 1.0;
   recording.keep_files = 2;
-  daemon::CaptureRecorder recorder("g", {"p1"}, 500.0, recording);
-  daemon::Sample s;
+  pipeline::CaptureRecorder recorder("g", {"p1"}, 500.0, recording);
+  realtime::Sample s;
   s.channel_count = 1;
   for (int i = 0; i < 5; ++i) {
     s.t = i * 1.0;

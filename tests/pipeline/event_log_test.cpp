@@ -9,7 +9,7 @@
 
 #include "config/yaml_reader.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 // A strict check of the JSON string syntax and of UTF-8 validity of the whole line.
@@ -79,4 +79,4 @@ TEST(Printable, EscapesControlsReplacesInvalidBytesAndCuts) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

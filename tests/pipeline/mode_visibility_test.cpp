@@ -20,7 +20,7 @@
 #include "tests/support/capture_slices.hpp"
 #include "tests/support/paths.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 TEST(ModeVisibilityCheck, NoiseFloorIsTheTransducersNoiseWithItsQuantisation) {
@@ -177,4 +177,4 @@ TEST(ModeVisibilityState, TheVerdictRoundTripsAndFormatOneFilesStillLoad) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

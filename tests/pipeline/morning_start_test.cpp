@@ -18,7 +18,7 @@
 #include "tests/support/capture_slices.hpp"
 #include "tests/support/paths.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kOnset = 1000.0;
@@ -98,4 +98,4 @@ TEST(MorningStart, PressuresOnlySayTheyCannotSeeALeakInsteadOfStayingSilent) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -9,14 +9,14 @@
 #include <algorithm>
 #include <string>
 
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 #include "pipeline/event_log.hpp"
-#include "views/metrics_text.hpp"
 #include "pipeline/worker.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "views/metrics_text.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 // config/demo.yaml's actuator, with `learn` and `on_delay` in place (state/events left out).
@@ -36,7 +36,7 @@ DaemonConfig demo_config(int learn_seconds, double on_delay_s) {
       std::to_string(on_delay_s) +
       ", off_delay_s: 10, latching: false}\n"
       "state: {directory: ''}\n";
-  return parse_config(config::ConfigNode::load_string(yaml, "demo.yaml"));
+  return daemon::parse_config(config::ConfigNode::load_string(yaml, "demo.yaml"));
 }
 
 capture::Capture demo_capture() {
@@ -60,7 +60,7 @@ struct ReloadRun {
 ReloadRun run_with_reload(const DaemonConfig& initial, const DaemonConfig& reloaded,
                           double reload_at) {
   const capture::Capture capture = demo_capture();
-  SpscRing<Sample> ring(1024);
+  realtime::SpscRing<realtime::Sample> ring(1024);
   GroupInput input;
   input.name = "main";
   input.ring = &ring;
@@ -80,7 +80,7 @@ ReloadRun run_with_reload(const DaemonConfig& initial, const DaemonConfig& reloa
       worker.apply(reloaded, {&sink});
       reloaded_once = true;
     }
-    Sample sample;
+    realtime::Sample sample;
     sample.tick = row;
     sample.t = t[row];
     sample.channel_count = static_cast<std::uint32_t>(columns.size());
@@ -143,4 +143,4 @@ TEST(Reload, TheLeakDuringRelearningIsNotReported) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

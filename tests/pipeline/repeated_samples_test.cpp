@@ -14,7 +14,7 @@
 #include "sim/simulate.hpp"
 #include "tests/support/capture_slices.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kLsb = 5.05e3;  // 12-bit pressure transducer, MODEL.md
@@ -126,4 +126,4 @@ TEST(RepeatedSamplesReplay, AFrozenChannelIsASensorFaultNotARepeatingAcquisition
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

@@ -11,7 +11,7 @@
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kOnset = 120.0;
@@ -116,4 +116,4 @@ TEST(Replay, TwoThreadsAtOnceGiveTheSameEventsAsOne) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

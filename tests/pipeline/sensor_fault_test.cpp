@@ -9,15 +9,15 @@
 #include <cmath>
 #include <optional>
 
+#include "daemon/config.hpp"
 #include "pipeline/actuator_monitor.hpp"
-#include "pipeline/config.hpp"
 #include "pipeline/event_log.hpp"
 #include "pipeline/replay.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/alloc_counter.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 constexpr double kRate = 500.0;
@@ -218,7 +218,7 @@ TEST(SensorFaultMonitor, PerSamplePathAllocatesNothing) {
   const EventPublisher publish = [&](const io::Event&) { ++events; };
   auto push_rows = [&](std::size_t from, std::size_t to) {
     std::size_t decisions = 0;
-    Sample sample;
+    realtime::Sample sample;
     for (std::size_t i = from; i < to; ++i) {
       sample.t = c.column("t")[i];
       sample.tick = i;
@@ -240,7 +240,7 @@ TEST(SensorFaultMonitor, PerSamplePathAllocatesNothing) {
 }
 
 TEST(SensorFaultConfig, TransducersAreConfigurablePerChannel) {
-  const auto config = parse_config(
+  const auto config = daemon::parse_config(
       config::ConfigNode::load_string("drivers: [{name: rig, type: sim, scenario: healthy}]\n"
                                       "actuators:\n"
                                       "  - name: a\n"
@@ -256,7 +256,7 @@ TEST(SensorFaultConfig, TransducersAreConfigurablePerChannel) {
   EXPECT_DOUBLE_EQ(a.p2_transducer.max, 20.7e6) << "MODEL.md's transducer by default";
   EXPECT_FALSE(a.x_transducer.enabled);
   try {
-    parse_config(
+    daemon::parse_config(
         config::ConfigNode::load_string("drivers: [{name: rig, type: sim, scenario: healthy}]\n"
                                         "actuators:\n"
                                         "  - name: a\n"
@@ -270,4 +270,4 @@ TEST(SensorFaultConfig, TransducersAreConfigurablePerChannel) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

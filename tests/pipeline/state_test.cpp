@@ -15,7 +15,7 @@
 #include "sim/simulate.hpp"
 #include "tests/support/paths.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
@@ -233,4 +233,4 @@ TEST(ReplayStateDir, ALeakOpenedWhileDownIsFoundOnlyWhenTheStateWasKept) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::pipeline

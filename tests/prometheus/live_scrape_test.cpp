@@ -87,7 +87,7 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
   const bool alarmed = test::eventually(
       [&] {
         try {
-          scrape = daemon::http_request("127.0.0.1", port, "GET", "/metrics").body;
+          scrape = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
         } catch (const std::exception&) {
           return false;
         }
@@ -177,7 +177,7 @@ TEST(PrometheusLiveScrape, LearnedStateAgeCountsFromTheSavedFileAcrossARestart) 
     return test::eventually(
         [&] {
           try {
-            scrape = daemon::http_request("127.0.0.1", port, "GET", "/metrics").body;
+            scrape = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
             return scrape.find("leakmon_detector_learning{") != std::string::npos;
           } catch (const std::exception&) {
             return false;

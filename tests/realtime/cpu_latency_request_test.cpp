@@ -10,9 +10,9 @@
 #include <fstream>
 #include <string>
 
-#include "pipeline/config.hpp"
+#include "daemon/config.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 namespace {
 
 namespace fs = std::filesystem;
@@ -77,8 +77,8 @@ TEST(CpuLatencyRequest, TheKernelAppliesTheRequestWhilePermitted) {
   EXPECT_EQ(effective, 0);
 }
 
-DaemonConfig parse(const std::string& extra) {
-  return parse_config(
+pipeline::DaemonConfig parse(const std::string& extra) {
+  return daemon::parse_config(
       config::ConfigNode::load_string("drivers: [{name: rig, type: sim, scenario: healthy}]\n"
                                       "actuators: [{name: a, channels: {p1: p1}}]\n" +
                                           extra,
@@ -104,4 +104,4 @@ TEST(CpuLatencyRequest, ConfiguredUnderRealtimeWithCyclictestsDefault) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

@@ -7,15 +7,15 @@
 #include <thread>
 
 #include "config/yaml_reader.hpp"
-#include "realtime/acquisition_loop.hpp"
-#include "pipeline/config.hpp"
-#include "pipeline/event_log.hpp"
-#include "pipeline/worker.hpp"
+#include "daemon/config.hpp"
 #include "io/replay/replay_driver.hpp"
 #include "io/sim/sim_driver.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
 #include "tests/support/alloc_counter.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 namespace {
 
 std::shared_ptr<const capture::Capture> ramp_capture(std::size_t rows) {
@@ -46,16 +46,17 @@ TEST(RealtimeLoop, AllocatesNothingOnItsThreadAndLosesNothing) {
   AcquisitionLoop loop(2'000'000, {&replay, sim.get()}, ring);
   ASSERT_EQ(loop.channel_count(), 2u + 6u);
 
-  DaemonConfig config = parse_config(config::ConfigNode::load_string(
+  pipeline::DaemonConfig config = daemon::parse_config(config::ConfigNode::load_string(
       "drivers: [{name: bench, type: replay, path: unused.csv}, {name: rig, type: sim, "
       "scenario: healthy}]\n"
       "actuators: [{name: a, channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x}}]\n",
       "test.yaml"));
-  std::vector<ChannelRef> channels;
+  std::vector<pipeline::ChannelRef> channels;
   for (const auto& c : replay.channels()) channels.push_back({"bench", c, std::nullopt});
   for (const auto& c : sim->channels()) channels.push_back({"rig", c, std::nullopt});
-  CollectingEventSink events;
-  Worker worker(config, {GroupInput{"main", &ring, channels, 2'000'000}}, {&events});
+  pipeline::CollectingEventSink events;
+  pipeline::Worker worker(config, {pipeline::GroupInput{"main", &ring, channels, 2'000'000}},
+                          {&events});
 
   std::atomic<bool> stop{false};
   std::uint64_t loop_allocations = 0;
@@ -128,4 +129,4 @@ TEST(RealtimeLoop, FiniteSourceEndsTheStream) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

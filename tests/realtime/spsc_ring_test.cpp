@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace leakmon::daemon {
+namespace leakmon::realtime {
 namespace {
 
 TEST(SpscRing, HoldsExactlyItsCapacityAndKeepsOrder) {
@@ -98,4 +98,4 @@ TEST(SpscRing, TwoThreadStressLosesNothingAndTearsNothing) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::realtime

@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 namespace {
 
 std::vector<std::string> lines_of(const std::string& text) {
@@ -213,12 +213,12 @@ TEST(MetricsText, StateSetHasOneSeriesPerNe107CategoryWithOnlyTheCurrentOneSet) 
   EXPECT_EQ(lines_of(bare.text()).front(), "s{status=\"ok\"} 1");
 }
 
-ActuatorStatus leaking_actuator() {
-  ActuatorStatus a;
+pipeline::ActuatorStatus leaking_actuator() {
+  pipeline::ActuatorStatus a;
   a.name = "lift";
   a.alarm = "internal_leakage";
   a.detector = "default";
-  a.state = AlarmState::active_unacknowledged;
+  a.state = pipeline::AlarmState::active_unacknowledged;
   a.learning = false;
   a.index_p1 = 1500.0;
   a.index_p2 = 1250.0;
@@ -233,7 +233,8 @@ ActuatorStatus leaking_actuator() {
 }
 
 TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAge) {
-  ActuatorStatus fresh;  // a second actuator that has no estimate, temperature or saved state
+  pipeline::ActuatorStatus
+      fresh;  // a second actuator that has no estimate, temperature or saved state
   fresh.name = "clamp";
   fresh.alarm = "internal_leakage";
   fresh.detector = "default";
@@ -242,7 +243,7 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.learning_seconds_left = 37.5;
   fresh.mode_visibility = 1.6;  // learned on a rig whose hydraulic mode did not show
   fresh.detection_blind = true;
-  const std::vector<ActuatorStatus> actuators = {leaking_actuator(), fresh};
+  const std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator(), fresh};
   PrometheusText out;
   actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
   const std::string text = out.text();
@@ -297,7 +298,7 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
 }
 
 TEST(MetricsText, ActuatorFamiliesHaveOneHeaderEachAndTheTextFormatShape) {
-  const std::vector<ActuatorStatus> actuators = {leaking_actuator()};
+  const std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator()};
   PrometheusText out;
   actuator_metrics(out, actuators, {{"lift", 5.0}}, 4.0);  // a clock that stepped back
   const std::string text = out.text();
@@ -316,4 +317,4 @@ TEST(MetricsText, ActuatorFamiliesHaveOneHeaderEachAndTheTextFormatShape) {
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views

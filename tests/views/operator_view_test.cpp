@@ -15,23 +15,23 @@
 
 #include <fmt/format.h>
 
-#include "realtime/acquisition_loop.hpp"
-#include "pipeline/config.hpp"
-#include "views/operator_view.hpp"
+#include "daemon/config.hpp"
 #include "pipeline/replay.hpp"
-#include "realtime/spsc_ring.hpp"
 #include "pipeline/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "realtime/spsc_ring.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/alloc_counter.hpp"
 #include "tests/support/paths.hpp"
+#include "views/operator_view.hpp"
 
-namespace leakmon::daemon {
+namespace leakmon::views {
 namespace {
 
-ViewSnapshot snapshot_of(const std::string& actuator, double score, AlarmState state) {
+ViewSnapshot snapshot_of(const std::string& actuator, double score, pipeline::AlarmState state) {
   ViewSnapshot s;
-  ActuatorStatus a;
+  pipeline::ActuatorStatus a;
   a.name = actuator;
   a.score = score;
   a.raise_threshold = 1.0;
@@ -49,7 +49,7 @@ ViewSnapshot snapshot_of(const std::string& actuator, double score, AlarmState s
 TEST(TrendHistory, KeepsTheNewestPointsInFixedMemory) {
   TrendHistory history(100, {"cyl"}, {"main"});
   EXPECT_EQ(history.memory_bytes(), 100 * (sizeof(TrendPoint) + sizeof(LoopPoint)));
-  ViewSnapshot snapshot = snapshot_of("cyl", 0.0, AlarmState::normal);
+  ViewSnapshot snapshot = snapshot_of("cyl", 0.0, pipeline::AlarmState::normal);
   {
     test::AllocationScope scope;
     for (int i = 0; i < 250; ++i) {
@@ -79,7 +79,7 @@ TEST(TrendHistory, KeepsTheNewestPointsInFixedMemory) {
 // docs/daemon.md "Live page": 4 h at 1 s is 14400 points, 1.4 MB per actuator and 0.5 MB per
 // sampling group. A change of TrendPoint or LoopPoint that breaks this must update the docs.
 TEST(TrendHistory, DefaultMemoryIsWhatTheDocumentationStates) {
-  const MetricsConfig defaults;
+  const pipeline::MetricsConfig defaults;
   const std::size_t capacity = trend_capacity(defaults.trend_seconds, defaults.trend_interval_s);
   EXPECT_EQ(capacity, 14400u);
   EXPECT_LE(TrendHistory::memory_bytes(capacity, 1, 0), 1'400'000u);
@@ -90,7 +90,7 @@ TEST(TrendHistory, DefaultMemoryIsWhatTheDocumentationStates) {
 
 TEST(TrendHistory, AnActuatorAddedByAReloadGetsItsRing) {
   TrendHistory history(10, {"a"}, {"main"});
-  history.record(1.0, snapshot_of("b", 1.0, AlarmState::normal));
+  history.record(1.0, snapshot_of("b", 1.0, pipeline::AlarmState::normal));
   ASSERT_NE(history.actuator("b"), nullptr);
   EXPECT_EQ(history.actuator("b")->points.size(), 1u);
   EXPECT_EQ(history.actuator("a")->points.size(), 0u);
@@ -102,19 +102,20 @@ TEST(OperatorView, SamplingTheWorkerAllocatesNothing) {
   sim::Scenario scenario = sim::preset("healthy", 3);
   scenario.duration_s = 12.0;
   const capture::Capture capture = sim::simulate(scenario);
-  DaemonConfig config = default_replay_config(capture);
+  pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
   config.actuators[0].name = "cylinder";
   const std::string driver = config.actuators[0].p1.driver;
-  std::vector<ChannelRef> channels;
+  std::vector<pipeline::ChannelRef> channels;
   std::vector<const std::vector<double>*> columns;
   for (const char* role : {"p1", "p2", "u", "x", "xref"}) {
     channels.push_back({driver, role, std::nullopt});
     columns.push_back(&capture.column(role));
   }
-  SpscRing<Sample> ring(4096);
+  realtime::SpscRing<realtime::Sample> ring(4096);
   std::vector<io::EventSink*> no_sinks;
-  Worker worker(config, {GroupInput{"main", &ring, channels, 2'000'000}}, no_sinks);
-  LoopCounters counters;  // an idle loop's, as the daemon reads them
+  pipeline::Worker worker(config, {pipeline::GroupInput{"main", &ring, channels, 2'000'000}},
+                          no_sinks);
+  realtime::LoopCounters counters;  // an idle loop's, as the daemon reads them
 
   OperatorView view(config, {"main"});
   view.set_source([&](ViewSnapshot& out) {
@@ -126,7 +127,7 @@ TEST(OperatorView, SamplingTheWorkerAllocatesNothing) {
   std::size_t row = 0;
   auto feed = [&](double seconds) {
     for (const std::size_t end = row + static_cast<std::size_t>(seconds * 500); row < end; ++row) {
-      Sample sample;
+      realtime::Sample sample;
       sample.tick = row;
       sample.t = capture.column("t")[row];
       sample.channel_count = static_cast<std::uint32_t>(columns.size());
@@ -164,7 +165,7 @@ TEST(OperatorView, SamplingTheWorkerAllocatesNothing) {
 
 // The sampler thread writes while HTTP readers read (run under TSan: label `threads`).
 TEST(OperatorView, SamplerThreadAndReadersShareTheHistorySafely) {
-  DaemonConfig config;
+  pipeline::DaemonConfig config;
   config.metrics.trend_interval_s = 0.01;
   config.metrics.trend_seconds = 60.0;
   std::atomic<int> calls{0};
@@ -172,7 +173,7 @@ TEST(OperatorView, SamplerThreadAndReadersShareTheHistorySafely) {
     OperatorView view(config, {"main"});
     auto sink = view.event_sink();
     view.start_sampling([&](ViewSnapshot& out) {
-      if (out.actuators.empty()) out = snapshot_of("cyl", 0.5, AlarmState::normal);
+      if (out.actuators.empty()) out = snapshot_of("cyl", 0.5, pipeline::AlarmState::normal);
       out.actuators[0].score = calls.fetch_add(1);
     });
     std::thread publisher([&] {
@@ -202,12 +203,12 @@ TEST(OperatorView, SamplerThreadAndReadersShareTheHistorySafely) {
 // What a browser loads when it opens the page on a full default history (4 h at 1 s): the
 // size of the first /api/trend answer, printed with the time it took (not asserted).
 TEST(OperatorView, FullDefaultHistoryAnswer) {
-  DaemonConfig config;
-  ActuatorConfig actuator;
+  pipeline::DaemonConfig config;
+  pipeline::ActuatorConfig actuator;
   actuator.name = "cyl";
   config.actuators.push_back(actuator);
   OperatorView view(config, {"main"});
-  ViewSnapshot source = snapshot_of("cyl", 0.5, AlarmState::normal);
+  ViewSnapshot source = snapshot_of("cyl", 0.5, pipeline::AlarmState::normal);
   int i = 0;
   view.set_source([&](ViewSnapshot& out) {
     source.actuators[0].score = 0.3 + 1e-4 * (i % 1000);
@@ -231,7 +232,7 @@ TEST(OperatorView, FullDefaultHistoryAnswer) {
 }
 
 TEST(OperatorView, ServesThePageAndItsAssetsFromTheBinary) {
-  DaemonConfig config;
+  pipeline::DaemonConfig config;
   const OperatorView view(config, {});
   for (const char* path : {"/", "/index.html", "/live.js", "/live.css", "/uplot.min.js",
                            "/uplot.min.css", "/favicon.svg"}) {
@@ -249,7 +250,7 @@ TEST(OperatorView, ServesThePageAndItsAssetsFromTheBinary) {
 }
 
 TEST(OperatorView, RecentEventsKeepTheNewestInOrder) {
-  DaemonConfig config;
+  pipeline::DaemonConfig config;
   const OperatorView view(config, {});
   auto sink = view.event_sink();
   for (int i = 0; i < 130; ++i) {
@@ -271,7 +272,7 @@ TEST(OperatorView, RecentEventsKeepTheNewestInOrder) {
 // file that is not one is refused with the line and field named.
 TEST(TrendHistory, TrendTextRoundTripsAndBadFilesNameTheirFault) {
   TrendHistory history(50, {"cyl"}, {"main"});
-  ViewSnapshot snapshot = snapshot_of("cyl", 0.25, AlarmState::active_unacknowledged);
+  ViewSnapshot snapshot = snapshot_of("cyl", 0.25, pipeline::AlarmState::active_unacknowledged);
   snapshot.actuators[0].index_p1 = 21345.678912;
   snapshot.actuators[0].oil_temperature = NAN;
   for (int i = 0; i < 5; ++i) history.record(1.8e9 + i, snapshot);
@@ -282,7 +283,7 @@ TEST(TrendHistory, TrendTextRoundTripsAndBadFilesNameTheirFault) {
   EXPECT_DOUBLE_EQ(back[4].index_p1, 21345.678912);
   EXPECT_DOUBLE_EQ(back[4].score, 0.25);
   EXPECT_TRUE(std::isnan(back[4].oil_temperature));
-  EXPECT_EQ(back[4].alarm, static_cast<std::uint8_t>(AlarmState::active_unacknowledged));
+  EXPECT_EQ(back[4].alarm, static_cast<std::uint8_t>(pipeline::AlarmState::active_unacknowledged));
   EXPECT_EQ(back[4].channel_status[1], static_cast<std::uint8_t>(io::DeviceStatus::failure));
   EXPECT_EQ(back[4].channel_status[2], TrendPoint::kNoChannel);
 
@@ -321,9 +322,9 @@ TEST(TrendHistory, TrendTextRoundTripsAndBadFilesNameTheirFault) {
 
 TEST(OperatorView, TrendAndEventsSurviveARestart) {
   const std::string dir = test::scratch_dir("OperatorView.TrendAndEventsSurviveARestart");
-  const StateStore store(dir + "/state");
-  DaemonConfig config;
-  ActuatorConfig actuator;
+  const pipeline::StateStore store(dir + "/state");
+  pipeline::DaemonConfig config;
+  pipeline::ActuatorConfig actuator;
   actuator.name = "cyl 1";  // a name that is not a file name as it is
   config.actuators.push_back(actuator);
   config.metrics.trend_interval_s = 1.0;
@@ -331,7 +332,7 @@ TEST(OperatorView, TrendAndEventsSurviveARestart) {
   const double before_stop = 1.8e9 + 1000.0;
   {
     OperatorView view(config, {"main"});
-    ViewSnapshot source = snapshot_of("cyl 1", 0.5, AlarmState::normal);
+    ViewSnapshot source = snapshot_of("cyl 1", 0.5, pipeline::AlarmState::normal);
     int i = 0;
     view.set_source([&](ViewSnapshot& out) {
       source.actuators[0].score = 0.01 * i;
@@ -353,7 +354,8 @@ TEST(OperatorView, TrendAndEventsSurviveARestart) {
   OperatorView view(config, {"main"});
   EXPECT_TRUE(view.restore_history(store, before_stop + 30.0).empty());
   EXPECT_EQ(view.restore_events(dir + "/events.jsonl"), 2u);
-  view.set_source([](ViewSnapshot& out) { out = snapshot_of("cyl 1", 0.125, AlarmState::normal); });
+  view.set_source(
+      [](ViewSnapshot& out) { out = snapshot_of("cyl 1", 0.125, pipeline::AlarmState::normal); });
   view.sample(before_stop + 30.0);
   const std::string trend = view.trend_json(0.0);
   EXPECT_NE(trend.find(fmt::format("\"time\":[{:.3f},", before_stop - 70)), std::string::npos)
@@ -379,7 +381,7 @@ TEST(OperatorView, TrendAndEventsSurviveARestart) {
 }
 
 TEST(OperatorView, AckNeedsTheConfiguredToken) {
-  DaemonConfig config;
+  pipeline::DaemonConfig config;
   OperatorView open_view(config, {});
   EXPECT_FALSE(open_view.handle({"POST", "/ack", "actuator=cyl"}).has_value())
       << "no token configured: the daemon acknowledges";
@@ -420,12 +422,12 @@ std::string metrics_config(const std::string& metrics) {
 }
 
 TEST(OperatorViewConfig, ANonLoopbackAddressNeedsAToken) {
-  const auto local = parse_config(config::ConfigNode::load_string(
+  const auto local = daemon::parse_config(config::ConfigNode::load_string(
       metrics_config("{address: 127.0.0.1, port: 9187}"), "local.yaml"));
   EXPECT_TRUE(local.metrics.ack_token.empty());
   try {
-    parse_config(config::ConfigNode::load_string(metrics_config("{address: 0.0.0.0, port: 9187}"),
-                                                 "open.yaml"));
+    daemon::parse_config(config::ConfigNode::load_string(
+        metrics_config("{address: 0.0.0.0, port: 9187}"), "open.yaml"));
     FAIL() << "0.0.0.0 without a token was accepted";
   } catch (const config::ConfigError& e) {
     const std::string message = e.what();
@@ -433,23 +435,23 @@ TEST(OperatorViewConfig, ANonLoopbackAddressNeedsAToken) {
     EXPECT_NE(message.find("metrics.address"), std::string::npos) << message;
     EXPECT_NE(message.find("ack_token"), std::string::npos) << message;
   }
-  EXPECT_THROW(parse_config(config::ConfigNode::load_string(
+  EXPECT_THROW(daemon::parse_config(config::ConfigNode::load_string(
                    metrics_config("{address: 0.0.0.0, ack_token: short}"), "short.yaml")),
                config::ConfigError);
-  const auto shared = parse_config(config::ConfigNode::load_string(
+  const auto shared = daemon::parse_config(config::ConfigNode::load_string(
       metrics_config("{address: 0.0.0.0, ack_token: 0123456789abcdef, trend_seconds: 600, "
                      "trend_interval_s: 0.5}"),
       "shared.yaml"));
   EXPECT_EQ(shared.metrics.ack_token, "0123456789abcdef");
   EXPECT_EQ(trend_capacity(shared.metrics.trend_seconds, shared.metrics.trend_interval_s), 1200u);
-  EXPECT_THROW(parse_config(config::ConfigNode::load_string(
+  EXPECT_THROW(daemon::parse_config(config::ConfigNode::load_string(
                    metrics_config("{trend_seconds: 604800, trend_interval_s: 0.1}"), "big.yaml")),
                config::ConfigError);
-  EXPECT_TRUE(is_loopback_address("127.0.0.1"));
-  EXPECT_TRUE(is_loopback_address("127.1.2.3"));
-  EXPECT_FALSE(is_loopback_address("0.0.0.0"));
-  EXPECT_FALSE(is_loopback_address("192.168.1.5"));
+  EXPECT_TRUE(daemon::is_loopback_address("127.0.0.1"));
+  EXPECT_TRUE(daemon::is_loopback_address("127.1.2.3"));
+  EXPECT_FALSE(daemon::is_loopback_address("0.0.0.0"));
+  EXPECT_FALSE(daemon::is_loopback_address("192.168.1.5"));
 }
 
 }  // namespace
-}  // namespace leakmon::daemon
+}  // namespace leakmon::views
