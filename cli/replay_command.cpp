@@ -40,7 +40,7 @@ int run_replay(int argc, char** argv) {
   std::ofstream out(args.get("events"));
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.get("events")));
   for (const auto& event : result.events) {
-    out << daemon::to_json_line(event) << '\n';
+    out << pipeline::to_json_line(event) << '\n';
     if (event.kind == io::EventKind::state_discarded) {
       fmt::print(stderr, "warning: {}\n", event.message);
     }

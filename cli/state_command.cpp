@@ -74,7 +74,7 @@ int show(const Target& target) {
     fmt::print("actuator {}: saved {}, detector {} ({}), alarm {}{}\n", state.actuator,
                utc(state.saved_unix), state.detector.kind(),
                learned(state.detector) ? "learned" : "still learning",
-               daemon::to_string(state.alarm), state.alarm_condition ? " (condition active)" : "");
+               pipeline::to_string(state.alarm), state.alarm_condition ? " (condition active)" : "");
     for (const auto& [name, value] : state.fingerprint.parts) {
       fmt::print("  {}: {}\n", name, value);
     }

@@ -25,6 +25,8 @@
 namespace leakmon::daemon {
 namespace {
 
+using capture::Role;
+
 std::string checked_name(const config::ConfigNode& node, std::set<std::string>& seen,
                          std::string_view what) {
   const auto name_node = node.at("name");
@@ -149,22 +151,26 @@ pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const Da
   pipeline::ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
-  channels.expect_keys({"p1", "p2", "u", "x", "xref", "ps", "temp"});
-  actuator.p1 = parse_channel_ref(channels.at("p1"), config);
-  for (auto [role, ref] : {std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
-                           std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
-    if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
+  std::vector<std::string> role_names;
+  for (const Role role : capture::kRoles) role_names.emplace_back(capture::to_string(role));
+  channels.expect_keys(role_names);
+  const pipeline::ChannelRef& p1 = actuator.channels[Role::p1];
+  actuator.channels[Role::p1] = parse_channel_ref(channels.at("p1"), config);
+  for (const Role role : capture::kRoles) {
+    if (role == Role::p1) continue;
+    if (auto n = channels.find(capture::to_string(role))) {
+      actuator.channels[role] = parse_channel_ref(*n, config);
+    }
   }
   // One actuator's signals must be sampled together (one group, one clock).
-  const pipeline::GroupConfig* group = pipeline::group_of_driver(config, actuator.p1.driver);
-  for (const auto* ref :
-       {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref, &actuator.ps, &actuator.temp}) {
-    if (ref->present() && pipeline::group_of_driver(config, ref->driver) != group) {
+  const pipeline::GroupConfig* group = pipeline::group_of_driver(config, p1.driver);
+  for (const Role role : capture::kRoles) {
+    const pipeline::ChannelRef& ref = actuator.channels[role];
+    if (ref.present() && pipeline::group_of_driver(config, ref.driver) != group) {
       channels.fail(
           fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
                       "actuator's channels must come from one sampling group",
-                      ref->text(), actuator.p1.text()));
+                      ref.text(), p1.text()));
     }
   }
   if (auto features = node.find("features")) actuator.features = parse_features(*features);
@@ -187,11 +193,13 @@ pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const Da
     actuator.alarm_name = alarm->get_string("name", actuator.alarm_name);
   }
   if (auto transducers = node.find("transducers")) {
-    transducers->expect_keys({"p1", "p2", "x"});
-    for (auto [role, spec] :
-         {std::pair{"p1", &actuator.p1_transducer}, std::pair{"p2", &actuator.p2_transducer},
-          std::pair{"x", &actuator.x_transducer}}) {
-      if (auto n = transducers->find(role)) *spec = parse_transducer(*n, *spec);
+    std::vector<std::string> checked;
+    for (const Role role : pipeline::kCheckedRoles) checked.emplace_back(capture::to_string(role));
+    transducers->expect_keys(checked);
+    for (const Role role : pipeline::kCheckedRoles) {
+      if (auto n = transducers->find(capture::to_string(role))) {
+        actuator.transducers[role] = parse_transducer(*n, actuator.transducers[role]);
+      }
     }
   }
   return actuator;
@@ -373,23 +381,20 @@ void check_channels(const DaemonConfig& config,
     }
   }
   for (const auto& actuator : config.actuators) {
-    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
-                            &actuator.ps, &actuator.temp}) {
-      if (!ref->present()) continue;
-      const auto& names = channels_of(ref->driver);
-      if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;
+    for (const Role role : capture::kRoles) {
+      const pipeline::ChannelRef& ref = actuator.channels[role];
+      if (!ref.present()) continue;
+      const auto& names = channels_of(ref.driver);
+      if (std::find(names.begin(), names.end(), ref.channel) != names.end()) continue;
       const std::string message = fmt::format("driver '{}' has no channel '{}' (it has: {})",
-                                              ref->driver, ref->channel, fmt::join(names, ", "));
-      if (ref->where) ref->where->fail(message);
+                                              ref.driver, ref.channel, fmt::join(names, ", "));
+      if (ref.where) ref.where->fail(message);
       throw config::ConfigError(fmt::format("{}: {}", config.source, message));
     }
     // Build the detector once so that its options and signal needs are checked now.
-    const pipeline::GroupConfig* group = pipeline::group_of_driver(config, actuator.p1.driver);
-    detect::AvailableSignals signals;
-    signals.p1 = true;
-    signals.p2 = actuator.p2.present();
-    signals.u = actuator.u.present();
-    signals.x = actuator.x.present();
+    const pipeline::GroupConfig* group =
+        pipeline::group_of_driver(config, actuator.channels[Role::p1].driver);
+    const detect::AvailableSignals signals = pipeline::available_signals(actuator.acquired());
     const double hop_seconds = static_cast<double>(actuator.features.step) *
                                static_cast<double>(group ? group->period_ns : 2'000'000) / 1e9;
     try {

@@ -14,6 +14,8 @@
 namespace leakmon::pipeline {
 namespace {
 
+using capture::Role;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double value_at(const realtime::Sample& sample, int index) {
@@ -23,11 +25,7 @@ double value_at(const realtime::Sample& sample, int index) {
 std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
                                                  const ChannelLayout& layout,
                                                  std::int64_t period_ns) {
-  detect::AvailableSignals signals;
-  signals.p1 = layout.p1 >= 0;
-  signals.p2 = layout.p2 >= 0;
-  signals.u = layout.u >= 0;
-  signals.x = layout.x >= 0;
+  const detect::AvailableSignals signals = available_signals(layout.acquired());
   const double hop_seconds =
       static_cast<double>(config.features.step) * static_cast<double>(period_ns) / 1e9;
   const config::ConfigNode* options = config.detector_options ? &*config.detector_options : nullptr;
@@ -45,31 +43,36 @@ ModeVisibilityCheck mode_check(const detect::TransducerSpec& spec) {
 
 }  // namespace
 
+capture::ByRole<bool> ChannelLayout::acquired() const {
+  capture::ByRole<bool> roles;
+  for (const Role role : capture::kRoles) roles[role] = index[role] >= 0;
+  return roles;
+}
+
 ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayout& layout,
                                  std::int64_t period_ns)
     : config_(config),
       layout_(layout),
-      features_(config.features, layout.p2 >= 0 ? 2 : 1),
+      features_(config.features, layout[Role::p2] >= 0 ? 2 : 1),
       detector_(build_detector(config, layout, period_ns)),
       alarm_(effective(config.alarm)),
       fingerprint_(state_fingerprint(config, period_ns)),
       hop_samples_p1_(config.features.step, kNaN),
       hop_samples_p2_(config.features.step, kNaN),
       activity_(config.features.window, kNaN),
-      index_input_(layout.p2 >= 0 ? 2 : 1, kNaN),
+      index_input_(layout[Role::p2] >= 0 ? 2 : 1, kNaN),
       sample_rate_hz_(1e9 / static_cast<double>(period_ns)),
       watch_mode_(detector_->needs_hydraulic_mode()),
-      mode_checks_{mode_check(config.p1_transducer), mode_check(config.p2_transducer)},
+      mode_checks_{mode_check(config.transducers[Role::p1]),
+                   mode_check(config.transducers[Role::p2])},
       period_ns_(period_ns) {
   const double rate = sample_rate_hz_;
   channels_.reserve(3);
-  for (auto [role, index, spec, slot] :
-       {std::tuple{"p1", layout.p1, &config.p1_transducer, &check_p1_},
-        std::tuple{"p2", layout.p2, &config.p2_transducer, &check_p2_},
-        std::tuple{"x", layout.x, &config.x_transducer, &check_x_}}) {
-    if (index < 0) continue;
-    *slot = static_cast<int>(channels_.size());
-    channels_.push_back(Channel{role, index, detect::SensorPlausibility(*spec, rate)});
+  for (const Role role : kCheckedRoles) {
+    if (layout[role] < 0) continue;
+    check_slot_[role] = static_cast<int>(channels_.size());
+    channels_.push_back(
+        Channel{role, layout[role], detect::SensorPlausibility(config.transducers[role], rate)});
   }
 }
 
@@ -86,24 +89,15 @@ void ActuatorMonitor::set_alarm_settings(const AlarmSettings& settings) {
 }
 
 void ActuatorMonitor::set_transducers(const ActuatorConfig& config) {
-  config_.p1_transducer = config.p1_transducer;
-  config_.p2_transducer = config.p2_transducer;
-  config_.x_transducer = config.x_transducer;
+  config_.transducers = config.transducers;
   for (auto& channel : channels_) {
-    const std::string_view role = channel.role;
-    const auto& spec = role == "p1"   ? config_.p1_transducer
-                       : role == "p2" ? config_.p2_transducer
-                                      : config_.x_transducer;
-    channel.check.reconfigure(spec, sample_rate_hz_);
+    channel.check.reconfigure(config_.transducers[channel.role], sample_rate_hz_);
   }
 }
 
 bool ActuatorMonitor::same_pipeline(const ActuatorConfig& other,
                                     const ChannelLayout& other_layout) const {
-  return layout_.p1 == other_layout.p1 && layout_.p2 == other_layout.p2 &&
-         layout_.u == other_layout.u && layout_.x == other_layout.x &&
-         layout_.xref == other_layout.xref && layout_.ps == other_layout.ps &&
-         layout_.temp == other_layout.temp && fingerprint_ == state_fingerprint(other, period_ns_);
+  return layout_ == other_layout && fingerprint_ == state_fingerprint(other, period_ns_);
 }
 
 std::string ActuatorMonitor::fingerprint_change(const StateFingerprint& other) const {
@@ -151,16 +145,16 @@ bool ActuatorMonitor::push(const realtime::Sample& sample, const EventPublisher&
     // a repeat), and the leak decision is held for the fault anyway.
     acquired[acquired_channels++] = channel.check.fault() == detect::SensorFault::none ? raw : kNaN;
   }
-  if (layout_.u >= 0) acquired[acquired_channels++] = value_at(sample, layout_.u);
+  if (layout_[Role::u] >= 0) acquired[acquired_channels++] = value_at(sample, layout_[Role::u]);
   suspect |= check_repeats(sample.t, {acquired.data(), acquired_channels}, publish);
   check_sensor_faults(sample.t, all_missing, publish);
   if (std::isnan(protected_from_) && !std::isnan(sample.t)) {
     protected_from_ = sample.t + learning_seconds();
   }
   if (!std::isnan(sample.t)) newest_t_ = sample.t;
-  delay_[arrived_ % delay_.size()] = {sample.t, value_at(sample, layout_.u),
-                                      value_at(sample, layout_.xref), value_at(sample, layout_.ps),
-                                      value_at(sample, layout_.temp)};
+  delay_[arrived_ % delay_.size()] = {
+      sample.t, value_at(sample, layout_[Role::u]), value_at(sample, layout_[Role::xref]),
+      value_at(sample, layout_[Role::ps]), value_at(sample, layout_[Role::temp])};
   ++arrived_;
   if (arrived_ <= kDelay) return false;
   const Unchecked& unchecked = delay_[(arrived_ - 1 - kDelay) % delay_.size()];
@@ -169,9 +163,9 @@ bool ActuatorMonitor::push(const realtime::Sample& sample, const EventPublisher&
   if (suspect) blocked_until_ = fed_ + config_.features.window + config_.features.step;
 
   auto checked = [&](int slot) { return slot < 0 ? kNaN : cleaned[slot]; };
-  const double p1 = checked(check_p1_);
-  const double p2 = checked(check_p2_);
-  const double x = checked(check_x_);
+  const double p1 = checked(check_slot_[Role::p1]);
+  const double p2 = checked(check_slot_[Role::p2]);
+  const double x = checked(check_slot_[Role::x]);
   index_input_[0] = p1;
   if (index_input_.size() > 1) index_input_[1] = p2;
   if (std::isnan(p1)) ++gap_samples_;
@@ -192,7 +186,7 @@ bool ActuatorMonitor::push(const realtime::Sample& sample, const EventPublisher&
   }
   ++hop_samples_;
 
-  activity_[activity_next_] = layout_.xref >= 0 ? unchecked.xref : x;
+  activity_[activity_next_] = layout_[Role::xref] >= 0 ? unchecked.xref : x;
   activity_next_ = (activity_next_ + 1) % activity_.size();
   if (activity_filled_ < activity_.size()) ++activity_filled_;
 
@@ -280,7 +274,7 @@ void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPubl
     event.t = t;
     event.actuator = config_.name;
     event.alarm = "sensor_fault";
-    event.channel = channel.role;
+    event.channel = capture::to_string(channel.role);
     if (channel.announced != detect::SensorFault::none) {
       event.kind = io::EventKind::alarm_cleared;
       event.fault = std::string(detect::to_string(channel.announced));
@@ -289,8 +283,8 @@ void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPubl
     if (fault != detect::SensorFault::none) {
       event.kind = io::EventKind::alarm_raised;
       event.fault = std::string(detect::to_string(fault));
-      event.message = fmt::format("{} {}: {} ({})", config_.name, channel.role, event.fault,
-                                  io::to_string(detect::device_status(fault)));
+      event.message = fmt::format("{} {}: {} ({})", config_.name, capture::to_string(channel.role),
+                                  event.fault, io::to_string(detect::device_status(fault)));
       publish(event);
     }
     channel.announced = fault;
@@ -314,16 +308,16 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
     if (channel < 0 || hop.gap || hop_samples_ == 0) return kNaN;
     return hop.sum / static_cast<double>(hop_samples_);
   };
-  observation.u = mean(hop_u_, layout_.u);
-  observation.x = mean(hop_x_, layout_.x);
-  observation.p1 = mean(hop_p1_, layout_.p1);
-  observation.p2 = mean(hop_p2_, layout_.p2);
-  observation.ps = mean(hop_ps_, layout_.ps);
-  observation.temp = mean(hop_temp_, layout_.temp);
+  observation.u = mean(hop_u_, layout_[Role::u]);
+  observation.x = mean(hop_x_, layout_[Role::x]);
+  observation.p1 = mean(hop_p1_, layout_[Role::p1]);
+  observation.p2 = mean(hop_p2_, layout_[Role::p2]);
+  observation.ps = mean(hop_ps_, layout_[Role::ps]);
+  observation.temp = mean(hop_temp_, layout_[Role::temp]);
   const std::size_t kept = std::min(hop_samples_, hop_samples_p1_.size());
-  if (layout_.p1 >= 0) observation.p1_samples = {hop_samples_p1_.data(), kept};
-  if (layout_.p2 >= 0) observation.p2_samples = {hop_samples_p2_.data(), kept};
-  if ((layout_.xref >= 0 || layout_.x >= 0) && activity_filled_ == activity_.size()) {
+  if (layout_[Role::p1] >= 0) observation.p1_samples = {hop_samples_p1_.data(), kept};
+  if (layout_[Role::p2] >= 0) observation.p2_samples = {hop_samples_p2_.data(), kept};
+  if ((layout_[Role::xref] >= 0 || layout_[Role::x] >= 0) && activity_filled_ == activity_.size()) {
     double sum = 0.0;
     for (double v : activity_) sum += v;
     const double m = sum / static_cast<double>(activity_.size());
@@ -470,7 +464,7 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     const auto& channel = channels_[i];
     auto& out = status.channels[i];
-    out.channel = channel.role;
+    out.channel = capture::to_string(channel.role);
     out.status = channel.check.status();
     out.fault = channel.check.fault();
     out.spikes_rejected = channel.check.spikes_rejected();

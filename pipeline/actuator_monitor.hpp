@@ -18,22 +18,28 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/alarm.hpp"
-#include "pipeline/config.hpp"
-#include "pipeline/mode_visibility.hpp"
-#include "pipeline/repeated_samples.hpp"
-#include "realtime/sample.hpp"
-#include "pipeline/state_store.hpp"
+#include "capture/role.hpp"
 #include "detect/detector.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
 #include "io/event.hpp"
+#include "pipeline/alarm.hpp"
+#include "pipeline/config.hpp"
+#include "pipeline/mode_visibility.hpp"
+#include "pipeline/repeated_samples.hpp"
+#include "pipeline/state_store.hpp"
+#include "realtime/sample.hpp"
 
 namespace leakmon::pipeline {
 
 // Where each role's value sits in a group's Sample; -1 when the actuator does not acquire it.
 struct ChannelLayout {
-  int p1 = -1, p2 = -1, u = -1, x = -1, xref = -1, ps = -1, temp = -1;
+  capture::ByRole<int> index{-1};
+
+  int operator[](capture::Role role) const { return index[role]; }
+  // The roles that have a place.
+  capture::ByRole<bool> acquired() const;
+  friend bool operator==(const ChannelLayout&, const ChannelLayout&) = default;
 };
 
 // One transducer channel's plausibility, for the metrics and `leakmon status`.
@@ -176,7 +182,7 @@ class ActuatorMonitor {
 
   // Plausibility of the transducer channels the layout has, and the fault each has announced.
   struct Channel {
-    const char* role;
+    capture::Role role;
     int index;
     detect::SensorPlausibility check;
     detect::SensorFault announced = detect::SensorFault::none;
@@ -191,7 +197,7 @@ class ActuatorMonitor {
   bool mode_judged_ = false;
   double healthy_index_ratio_ = io::kNoValue;
   bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision
-  int check_p1_ = -1, check_p2_ = -1, check_x_ = -1;  // indices into channels_
+  capture::ByRole<int> check_slot_{-1};  // by checked role, its index into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {
     double t, u, xref, ps, temp;

@@ -3,17 +3,20 @@
 // (daemon/config.hpp).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "capture/role.hpp"
 #include "config/paths.hpp"
 #include "config/yaml_reader.hpp"
-#include "pipeline/alarm.hpp"
+#include "detect/factory.hpp"
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
+#include "pipeline/alarm.hpp"
 
 namespace leakmon::pipeline {
 
@@ -43,22 +46,36 @@ struct ChannelRef {
   std::string text() const { return driver.empty() ? channel : driver + "." + channel; }
 };
 
+// The roles whose transducers have a plausibility check (detect/sensor_plausibility.hpp): the
+// chamber pressures and the position.
+inline constexpr std::array<capture::Role, 3> kCheckedRoles = {capture::Role::p1, capture::Role::p2,
+                                                               capture::Role::x};
+
+// MODEL.md's transducers: 0-20.7 MPa 12 bit 5 kPa noise for the pressures, 10 um resolution with
+// 5 um noise for the position (the other roles have no check: their entry is unused).
+capture::ByRole<detect::TransducerSpec> default_transducers();
+
 struct ActuatorConfig {
   std::string name;
-  // Signals by role; p1 is required, the others optional (MODEL.md names).
-  ChannelRef p1, p2, u, x, xref, ps, temp;
+  // Signals by role (capture/role.hpp); p1 is required, the others optional.
+  capture::ByRole<ChannelRef> channels;
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   std::string alarm_name = "internal_leakage";
-  // The transducers behind p1, p2 and x, for their plausibility checks (`transducers:`);
-  // defaults are MODEL.md's: 0-20.7 MPa 12 bit 5 kPa noise, position 10 um with 5 um noise.
-  detect::TransducerSpec p1_transducer = detect::TransducerSpec::pressure();
-  detect::TransducerSpec p2_transducer = detect::TransducerSpec::pressure();
-  detect::TransducerSpec x_transducer = detect::TransducerSpec::position();
+  // The transducers behind the checked roles (kCheckedRoles), for their plausibility checks
+  // (`transducers:`).
+  capture::ByRole<detect::TransducerSpec> transducers = default_transducers();
+
+  // Which roles the actuator acquires.
+  capture::ByRole<bool> acquired() const;
 };
+
+// What a detector is told it gets (detect/factory.hpp), from the roles acquired: the one place
+// the configuration check, the state fingerprint and the monitor build it.
+detect::AvailableSignals available_signals(const capture::ByRole<bool>& acquired);
 
 struct RecordingConfig {
   std::string directory;                    // empty: no recording

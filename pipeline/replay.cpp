@@ -38,14 +38,14 @@ DaemonConfig bind_to_capture(const capture::Capture& capture, const DaemonConfig
   bound.groups = {group};
   bound.recording = {};
   for (auto& actuator : bound.actuators) {
-    for (auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
-                      &actuator.ps, &actuator.temp}) {
-      if (!ref->present()) continue;
-      ref->driver = kCaptureDriver;
-      if (ref->channel == "t" || !capture.has(ref->channel)) {
+    for (const capture::Role role : capture::kRoles) {
+      ChannelRef& ref = actuator.channels[role];
+      if (!ref.present()) continue;
+      ref.driver = kCaptureDriver;
+      if (ref.channel == "t" || !capture.has(ref.channel)) {
         const std::string message =
-            fmt::format("the capture {} has no column '{}'", capture.path, ref->channel);
-        if (ref->where) ref->where->fail(message);
+            fmt::format("the capture {} has no column '{}'", capture.path, ref.channel);
+        if (ref.where) ref.where->fail(message);
         throw capture::CaptureError(message);
       }
     }
@@ -66,11 +66,10 @@ DaemonConfig default_replay_config(const capture::Capture& capture) {
   config.source = "built-in replay defaults";
   ActuatorConfig actuator;
   actuator.name = "actuator";
-  for (auto [role, ref] :
-       {std::pair{"p1", &actuator.p1}, std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-        std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
-        std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
-    if (capture.has(role)) *ref = ChannelRef{kCaptureDriver, role, std::nullopt};
+  for (const capture::Role role : capture::kRoles) {
+    const std::string column(capture::to_string(role));
+    if (capture.has(column))
+      actuator.channels[role] = ChannelRef{kCaptureDriver, column, std::nullopt};
   }
   config.actuators.push_back(actuator);
   config.metrics.port = 0;

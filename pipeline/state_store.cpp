@@ -86,17 +86,17 @@ std::string rest_after(std::string_view line, std::string_view key) {
 
 StateFingerprint state_fingerprint(const ActuatorConfig& actuator, std::int64_t period_ns) {
   StateFingerprint fp;
-  detect::AvailableSignals signals;
-  signals.p1 = actuator.p1.present();
-  signals.p2 = actuator.p2.present();
-  signals.u = actuator.u.present();
-  signals.x = actuator.x.present();
+  const detect::AvailableSignals signals = available_signals(actuator.acquired());
   const std::string kind =
       actuator.detector == "default" ? detect::default_detector_kind(signals) : actuator.detector;
-  fp.parts.emplace_back(
-      "channels", fmt::format("p1={} p2={} u={} x={} xref={} ps={} temp={}", actuator.p1.channel,
-                              actuator.p2.channel, actuator.u.channel, actuator.x.channel,
-                              actuator.xref.channel, actuator.ps.channel, actuator.temp.channel));
+  // "p1=... p2=... u=... x=... xref=... ps=... temp=...": what the fingerprint hash of every
+  // saved state reads, so the roles' order and names are part of the state format.
+  std::string channels;
+  for (const capture::Role role : capture::kRoles) {
+    if (!channels.empty()) channels += ' ';
+    channels += fmt::format("{}={}", capture::to_string(role), actuator.channels[role].channel);
+  }
+  fp.parts.emplace_back("channels", channels);
   const auto& f = actuator.features;
   fp.parts.emplace_back(
       "features", fmt::format("wavelet={} level={} window={} step={} mode={}", f.wavelet, f.level,
@@ -114,7 +114,7 @@ std::vector<std::pair<std::string, StateFingerprint>> state_fingerprints(
     const DaemonConfig& config) {
   std::vector<std::pair<std::string, StateFingerprint>> out;
   for (const auto& actuator : config.actuators) {
-    const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
+    const GroupConfig* group = group_of_driver(config, actuator.channels[capture::Role::p1].driver);
     const std::int64_t period = group != nullptr ? group->period_ns : 0;
     out.emplace_back(actuator.name, state_fingerprint(actuator, period));
   }

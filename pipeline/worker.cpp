@@ -20,8 +20,10 @@ ChannelLayout layout_of(const ActuatorConfig& actuator, const std::vector<Channe
     }
     return -1;
   };
-  return ChannelLayout{find(actuator.p1),   find(actuator.p2), find(actuator.u),   find(actuator.x),
-                       find(actuator.xref), find(actuator.ps), find(actuator.temp)};
+  ChannelLayout layout;
+  for (const capture::Role role : capture::kRoles)
+    layout.index[role] = find(actuator.channels[role]);
+  return layout;
 }
 
 Worker::Worker(const DaemonConfig& config, std::vector<GroupInput> groups,
@@ -54,7 +56,7 @@ void Worker::build_monitors(const DaemonConfig& config, GroupState& group,
   std::vector<std::unique_ptr<ActuatorMonitor>> monitors;
   for (const auto& actuator : config.actuators) {
     const ChannelLayout layout = layout_of(actuator, group.input.channels);
-    if (layout.p1 < 0) continue;  // another group's actuator
+    if (layout[capture::Role::p1] < 0) continue;  // another group's actuator
     std::unique_ptr<ActuatorMonitor> kept;
     const ActuatorMonitor* replaced = nullptr;  // same actuator, learned state no longer valid
     if (previous != nullptr) {

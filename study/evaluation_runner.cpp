@@ -123,9 +123,9 @@ config::ConfigNode detector_options(const EvaluationOptions& options) {
                                          "leakmon evaluate");
 }
 
-daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
+pipeline::DaemonConfig evaluation_config(const capture::Capture& capture,
                                        const EvaluationOptions& options) {
-  daemon::DaemonConfig config = pipeline::default_replay_config(capture);
+  pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
   const pipeline::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
   const auto detector_config = detector_options(options);
@@ -137,11 +137,12 @@ daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
       a.name = actuator_name(c, t);
       a.detector = candidate.kind;
       a.detector_options = detector_config;
-      if (!candidate.p2) a.p2 = {};
-      if (!candidate.u) a.u = {};
-      if (!candidate.x) a.x = {};
-      if (!candidate.temp) a.temp = {};
-      a.ps = {};  // the detectors read the supply from the chamber pressures at rest
+      if (!candidate.p2) a.channels[capture::Role::p2] = {};
+      if (!candidate.u) a.channels[capture::Role::u] = {};
+      if (!candidate.x) a.channels[capture::Role::x] = {};
+      if (!candidate.temp) a.channels[capture::Role::temp] = {};
+      a.channels[capture::Role::ps] =
+          {};  // the detectors read the supply from the chamber pressures at rest
       const double raise = candidate.raise_thresholds[t];
       a.alarm.raise_threshold = raise;
       a.alarm.clear_threshold =

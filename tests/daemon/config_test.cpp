@@ -17,6 +17,8 @@
 namespace leakmon::daemon {
 namespace {
 
+using capture::Role;
+
 std::string error_of(const std::string& yaml) {
   try {
     parse_config(config::ConfigNode::load_string(yaml, "rig.yaml"));
@@ -36,10 +38,10 @@ TEST(DaemonConfig, MinimalConfigGetsTheDocumentedDefaults) {
   EXPECT_EQ(config.groups[0].priority, 80);
   EXPECT_EQ(config.groups[0].drivers, std::vector<std::string>{"rig"});
   const auto& a = config.actuators.at(0);
-  EXPECT_EQ(a.p1.driver, "rig");
-  EXPECT_EQ(a.p1.channel, "p1");
-  EXPECT_EQ(a.x.channel, "x");
-  EXPECT_FALSE(a.p2.present());
+  EXPECT_EQ(a.channels[Role::p1].driver, "rig");
+  EXPECT_EQ(a.channels[Role::p1].channel, "p1");
+  EXPECT_EQ(a.channels[Role::x].channel, "x");
+  EXPECT_FALSE(a.channels[Role::p2].present());
   EXPECT_EQ(a.features.window, 400u);
   EXPECT_EQ(a.detector, "default");
   EXPECT_TRUE(std::isnan(a.alarm.raise_threshold)) << "left to the detector";

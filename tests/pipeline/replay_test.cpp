@@ -14,6 +14,8 @@
 namespace leakmon::pipeline {
 namespace {
 
+using capture::Role;
+
 constexpr double kOnset = 120.0;
 
 capture::Capture leaking_capture(std::uint64_t seed, std::string_view preset) {
@@ -48,10 +50,10 @@ TEST(Replay, DefaultConfigUsesTheKnownColumnsPresent) {
   const DaemonConfig config = default_replay_config(capture);
   ASSERT_EQ(config.actuators.size(), 1u);
   const auto& actuator = config.actuators.front();
-  EXPECT_EQ(actuator.p1.channel, "p1");
-  EXPECT_EQ(actuator.x.channel, "x");
-  EXPECT_FALSE(actuator.p2.present());
-  EXPECT_FALSE(actuator.u.present());
+  EXPECT_EQ(actuator.channels[Role::p1].channel, "p1");
+  EXPECT_EQ(actuator.channels[Role::x].channel, "x");
+  EXPECT_FALSE(actuator.channels[Role::p2].present());
+  EXPECT_FALSE(actuator.channels[Role::u].present());
   EXPECT_EQ(config.groups.front().period_ns, 2'000'000);
   EXPECT_EQ(actuator.features.window, 400u);
   EXPECT_EQ(actuator.features.step, 20u);

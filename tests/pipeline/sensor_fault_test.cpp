@@ -20,6 +20,8 @@
 namespace leakmon::pipeline {
 namespace {
 
+using capture::Role;
+
 constexpr double kRate = 500.0;
 // The default detector settles 2 s and learns 90 s; the fault comes after that, the leak later.
 constexpr double kFreezeFrom = 120.0, kFreezeTo = 150.0, kLeakOnset = 210.0;
@@ -119,7 +121,7 @@ TEST(SensorFaultReplay, WithoutTheCheckAFrozenP1LooksLikeALeak) {
   capture::Capture frozen = clean;
   freeze(frozen, "p1", kFreezeFrom, kFreezeTo);
   DaemonConfig config = default_replay_config(frozen);
-  config.actuators[0].p1_transducer.enabled = false;
+  config.actuators[0].transducers[Role::p1].enabled = false;
   const ReplayResult result = replay_capture(frozen, config);
   const auto leaks = events_of(result, io::EventKind::alarm_raised, "internal_leakage");
   ASSERT_FALSE(leaks.empty());
@@ -206,12 +208,11 @@ TEST(SensorFaultMonitor, PerSamplePathAllocatesNothing) {
   const auto& actuator = config.actuators.at(0);
   ChannelLayout layout;
   std::vector<const std::vector<double>*> columns;
-  for (auto [role, slot] :
-       {std::pair{"p1", &layout.p1}, std::pair{"p2", &layout.p2}, std::pair{"u", &layout.u},
-        std::pair{"x", &layout.x}, std::pair{"xref", &layout.xref}}) {
-    if (!c.has(role)) continue;
-    *slot = static_cast<int>(columns.size());
-    columns.push_back(&c.column(role));
+  for (const Role role : {Role::p1, Role::p2, Role::u, Role::x, Role::xref}) {
+    const std::string column(capture::to_string(role));
+    if (!c.has(column)) continue;
+    layout.index[role] = static_cast<int>(columns.size());
+    columns.push_back(&c.column(column));
   }
   ActuatorMonitor monitor(actuator, layout, 2'000'000);
   std::size_t events = 0;
@@ -250,11 +251,11 @@ TEST(SensorFaultConfig, TransducersAreConfigurablePerChannel) {
                                       "      x: {check: false}\n",
                                       "rig.yaml"));
   const auto& a = config.actuators.at(0);
-  EXPECT_DOUBLE_EQ(a.p1_transducer.max, 35e6);
-  EXPECT_DOUBLE_EQ(a.p1_transducer.resolution, 35e6 / 65536.0);
-  EXPECT_DOUBLE_EQ(a.p1_transducer.noise_sigma, 2000.0);
-  EXPECT_DOUBLE_EQ(a.p2_transducer.max, 20.7e6) << "MODEL.md's transducer by default";
-  EXPECT_FALSE(a.x_transducer.enabled);
+  EXPECT_DOUBLE_EQ(a.transducers[Role::p1].max, 35e6);
+  EXPECT_DOUBLE_EQ(a.transducers[Role::p1].resolution, 35e6 / 65536.0);
+  EXPECT_DOUBLE_EQ(a.transducers[Role::p1].noise_sigma, 2000.0);
+  EXPECT_DOUBLE_EQ(a.transducers[Role::p2].max, 20.7e6) << "MODEL.md's transducer by default";
+  EXPECT_FALSE(a.transducers[Role::x].enabled);
   try {
     daemon::parse_config(
         config::ConfigNode::load_string("drivers: [{name: rig, type: sim, scenario: healthy}]\n"

@@ -18,15 +18,17 @@
 namespace leakmon::pipeline {
 namespace {
 
+using capture::Role;
+
 namespace fs = std::filesystem;
 
 ActuatorConfig actuator(const std::string& name) {
   ActuatorConfig a;
   a.name = name;
-  a.p1 = {"rig", "p1", std::nullopt};
-  a.p2 = {"rig", "p2", std::nullopt};
-  a.u = {"rig", "u", std::nullopt};
-  a.x = {"rig", "x", std::nullopt};
+  a.channels[Role::p1] = {"rig", "p1", std::nullopt};
+  a.channels[Role::p2] = {"rig", "p2", std::nullopt};
+  a.channels[Role::u] = {"rig", "u", std::nullopt};
+  a.channels[Role::x] = {"rig", "x", std::nullopt};
   return a;
 }
 
@@ -135,8 +137,12 @@ TEST(StateStore, DamagedNewerOrChangedFilesAreSetAsideWithAWarning) {
   EXPECT_NE(warning.find("window=512"), std::string::npos) << warning;
   // Each part of the fingerprint matters.
   const auto base = state_fingerprint(actuator("ram"), 2'000'000);
+  // The channels part as every saved state has it (its hash decides whether the state loads).
+  ASSERT_FALSE(base.parts.empty());
+  EXPECT_EQ(base.parts[0].first, "channels");
+  EXPECT_EQ(base.parts[0].second, "p1=p1 p2=p2 u=u x=x xref= ps= temp=");
   ActuatorConfig other_channel = actuator("ram");
-  other_channel.p2.channel = "p2b";
+  other_channel.channels[Role::p2].channel = "p2b";
   ActuatorConfig other_detector = actuator("ram");
   other_detector.detector = "index_cusum";
   ActuatorConfig other_wavelet = actuator("ram");
@@ -147,7 +153,7 @@ TEST(StateStore, DamagedNewerOrChangedFilesAreSetAsideWithAWarning) {
   EXPECT_FALSE(state_fingerprint(actuator("ram"), 1'000'000) == base);
   // Driver names do not: a state learned from a capture fits the daemon.
   ActuatorConfig other_driver = actuator("ram");
-  other_driver.p1.driver = other_driver.p2.driver = "capture";
+  other_driver.channels[Role::p1].driver = other_driver.channels[Role::p2].driver = "capture";
   EXPECT_TRUE(state_fingerprint(other_driver, 2'000'000) == base);
 }
 

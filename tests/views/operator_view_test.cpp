@@ -104,7 +104,7 @@ TEST(OperatorView, SamplingTheWorkerAllocatesNothing) {
   const capture::Capture capture = sim::simulate(scenario);
   pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
   config.actuators[0].name = "cylinder";
-  const std::string driver = config.actuators[0].p1.driver;
+  const std::string driver = config.actuators[0].channels[capture::Role::p1].driver;
   std::vector<pipeline::ChannelRef> channels;
   std::vector<const std::vector<double>*> columns;
   for (const char* role : {"p1", "p2", "u", "x", "xref"}) {
