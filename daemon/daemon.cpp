@@ -8,14 +8,18 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <limits>
 
-#include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
-#include "pipeline/event_log.hpp"
-#include "http/http_router.hpp"
 #include "daemon/output_registry.hpp"
+#include "daemon/routes.hpp"
+#include "http/http_router.hpp"
+#include "pipeline/event_log.hpp"
+#include "views/metrics_text.hpp"
+#include "views/status_json.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -86,14 +90,12 @@ void Daemon::attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& 
                              bool attach) const {
   io::ReadingSource source;
   if (attach) {
-    const pipeline::Worker* worker = worker_.get();
-    source = [worker] {
+    source = [this] {
+      views::ServiceSnapshot snapshot;
+      fill_actuators(snapshot);  // all a feature message reads
       std::vector<io::ActuatorReading> readings;
-      for (const auto& a : worker->status()) {
-        readings.push_back({a.name, a.t, a.index_p1, a.score,
-                            units::lpm_per_mpa(a.leak_coefficient),
-                            units::lpm_per_mpa(a.leak_coefficient_ci),
-                            std::string(to_string(a.state)), a.learning});
+      for (const auto& a : snapshot.actuators) {
+        readings.push_back({a.name, views::features_json(snapshot, a)});
       }
       return readings;
     };
@@ -234,6 +236,7 @@ void Daemon::start() {
                  group->realtime.fifo ? fmt::format("SCHED_FIFO {}", group->config.priority)
                                       : std::string("normal scheduling"));
   }
+  set_ack_token(config_.metrics.ack_token);
   if (config_.metrics.port != 0) {
     endpoint_ = std::make_unique<http::HttpEndpoint>(
         config_.metrics.address, config_.metrics.port,
@@ -241,7 +244,7 @@ void Daemon::start() {
         &http_counters_);
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
-    operator_view_->start_sampling([this](views::ViewSnapshot& out) { fill_view_snapshot(out); });
+    operator_view_->start_sampling([this](views::ServiceSnapshot& out) { fill_snapshot(out); });
     spdlog::info("live page on http://{}:{}/ ({:.1f} MB of trend history)", config_.metrics.address,
                  endpoint_->port(), static_cast<double>(operator_view_->history_bytes()) / 1e6);
   }
@@ -318,11 +321,6 @@ void Daemon::stop() {
   worker_.reset();
   std::lock_guard lock(sinks_mutex_);
   sinks_.clear();
-}
-
-std::map<std::string, double> Daemon::state_saved_unix() const {
-  const std::lock_guard lock(state_saved_mutex_);
-  return state_saved_unix_;
 }
 
 bool Daemon::all_sources_ended() const {
@@ -422,7 +420,7 @@ void Daemon::reload() {
       sinks_.swap(sinks);  // the old sinks go only after the worker stopped using them
     }
     config_ = std::move(next);
-    if (operator_view_) operator_view_->set_ack_token(config_.metrics.ack_token);
+    set_ack_token(config_.metrics.ack_token);
     ++reloads_;
     last_reload_ok_ = true;
     event.kind = io::EventKind::config_reloaded;
@@ -481,30 +479,105 @@ int Daemon::run(double duration_s) {
 // One route per line: the path, its method, and what serves it (http/http_router.hpp answers
 // 405 with Allow for another method on a known path, 404 for the rest).
 http::HttpResponse Daemon::handle(const http::HttpRequest& request) {
-  if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
+  if (auto answer = operator_view_->handle(request)) return *answer;  // the page and its api
   const http::HttpRoute routes[] = {
-      {"/metrics", "GET", [this](const http::HttpRequest&) { return metrics_response(); }},
+      {"/metrics", "GET", [this](const http::HttpRequest&) { return metrics(); }},
       {"/status", "GET", [this](const http::HttpRequest& r) { return status(r); }},
       {"/ack", "POST", [this](const http::HttpRequest& r) { return acknowledge(r); }},
   };
   return http::route(routes, request);
 }
 
-http::HttpResponse Daemon::metrics_response() const {
-  return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
+void Daemon::set_ack_token(const std::string& token) {
+  {
+    const std::lock_guard lock(ack_token_mutex_);
+    ack_token_ = token;
+  }
+  if (operator_view_) operator_view_->set_ack_token_required(!token.empty());
+}
+
+void Daemon::fill_actuators(views::ServiceSnapshot& out) const {
+  out.unix_time =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  worker_->status_into(out.actuators);
+  const std::lock_guard lock(state_saved_mutex_);
+  for (auto& a : out.actuators) {
+    const auto saved = state_saved_unix_.find(a.name);
+    a.learned_state_saved_unix =
+        saved == state_saved_unix_.end() ? std::numeric_limits<double>::quiet_NaN() : saved->second;
+  }
+}
+
+void Daemon::fill_snapshot(views::ServiceSnapshot& out) const {
+  const std::int64_t now_ns = realtime::monotonic_now_ns();
+  fill_actuators(out);
+  out.version = LEAKMON_VERSION;
+  out.config = config_path_;
+  out.uptime_s = static_cast<double>(now_ns - started_ns_) / 1e9;
+  out.reload.ok = last_reload_ok_.load();
+  out.reload.reloads = reloads_.load();
+  out.reload.failures = reload_failures_.load();
+  out.reload.last_unix = last_reload_unix_.load();
+  out.cpu_latency_request_held = cpu_latency_.held();
+  out.samples_processed = worker_->samples_processed();
+  out.events = worker_->events_published();
+  views::summarize(worker_->decision_latency(), out.decision_latency);
+  out.groups.resize(groups_.size());
+  for (std::size_t i = 0; i < groups_.size(); ++i) {
+    const Group& g = *groups_[i];
+    views::read_group(out.groups[i], g.config.name, g.loop->counters(), g.ring->capacity(),
+                      g.realtime.fifo, now_ns);
+  }
+  out.drivers.resize(drivers_.size());
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.drivers[i].name = drivers_[i]->name();
+    out.drivers[i].health = drivers_[i]->health();
+  }
+  // Outputs' own counters (io::EventSink::metrics), sorted by name: one family per name.
+  out.output_metrics.clear();
+  {
+    std::lock_guard lock(sinks_mutex_);
+    for (const auto& sink : sinks_) {
+      for (const auto& metric : sink->metrics()) {
+        out.output_metrics.push_back({std::string(sink->name()), metric});
+      }
+    }
+  }
+  std::stable_sort(out.output_metrics.begin(), out.output_metrics.end(),
+                   [](const auto& a, const auto& b) { return a.metric.name < b.metric.name; });
+  out.http.requests = http_counters_.requests.load();
+  out.http.rejected = http_counters_.rejected.load();
+  out.http.deadline_closes = http_counters_.deadline_closes.load();
+  out.http.open_connections = http_counters_.open_connections.load();
+}
+
+http::HttpResponse Daemon::metrics() const {
+  views::ServiceSnapshot snapshot;
+  fill_snapshot(snapshot);
+  return {200, "text/plain; version=0.0.4; charset=utf-8", views::metrics_text(snapshot)};
 }
 
 http::HttpResponse Daemon::status(const http::HttpRequest& request) const {
-  const http::StatusFormat format = http::status_format(request);
+  const StatusFormat format = status_format(request);
   if (format.error) return *format.error;
-  if (format.text) return {200, "text/plain; charset=utf-8", status_text()};
-  return {200, "application/json", status_json()};
+  views::ServiceSnapshot snapshot;
+  fill_snapshot(snapshot);
+  const std::string json = views::status_json(snapshot);
+  if (format.text) return {200, "text/plain; charset=utf-8", views::status_text_from_json(json)};
+  return {200, "application/json", json};
 }
 
-// POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME. Anything else
-// acknowledges nothing (http/http_router.hpp ack_selection()).
+// POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME, and with
+// metrics.ack_token set only with the token. Anything else acknowledges nothing
+// (daemon/routes.hpp).
 http::HttpResponse Daemon::acknowledge(const http::HttpRequest& request) {
-  const http::AckSelection selection = http::ack_selection(request);
+  std::string token;
+  {
+    const std::lock_guard lock(ack_token_mutex_);
+    token = ack_token_;
+  }
+  if (auto refusal = ack_refusal(request, token)) return *refusal;
+  const AckSelection selection = ack_selection(request);
   if (selection.error) return *selection.error;
   const std::size_t matched = worker_->acknowledge(selection.actuator);
   if (matched == 0) {

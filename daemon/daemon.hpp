@@ -25,6 +25,7 @@
 #include "realtime/acquisition_loop.hpp"
 #include "realtime/cpu_latency_request.hpp"
 #include "views/operator_view.hpp"
+#include "views/snapshot.hpp"
 
 namespace leakmon::daemon {
 
@@ -40,12 +41,13 @@ class Daemon {
   // Throws config::ConfigError / io::DriverError when the configuration cannot start.
   int run(double duration_s = 0);
 
-  // Prometheus text exposition of everything the daemon counts (views/metrics_text.cpp).
-  std::string metrics_text() const;
-  // GET /status: the status as JSON, and the human summary made from it that `leakmon status`
-  // prints (views/status_json.cpp).
-  std::string status_json() const;
-  std::string status_text() const;
+  // The service's state as every view formats it (views/snapshot.hpp): into `out` in place, so
+  // that the live page's sampler refills a warm snapshot. Any thread; the worker's mutex is taken
+  // for the actuators, as it is for everything the worker shares.
+  void fill_snapshot(views::ServiceSnapshot& out) const;
+  // Its wall time and actuators only: what an output's feature message reads, from the output's
+  // own thread (no driver, output or HTTP counter is asked).
+  void fill_actuators(views::ServiceSnapshot& out) const;
 
  private:
   struct Group {
@@ -77,16 +79,15 @@ class Daemon {
   // The learned state; the page's trend too when `with_trend` (it is megabytes: written every
   // kTrendSaveSeconds and at shutdown, not with every state save).
   void save_state(bool with_trend);
-  // By actuator, when its learned state in the state directory was saved (for the metrics).
-  std::map<std::string, double> state_saved_unix() const;
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
   http::HttpResponse handle(const http::HttpRequest& request);
-  // The live page's sample of the status (views/operator_view.cpp).
-  void fill_view_snapshot(views::ViewSnapshot& out) const;
   http::HttpResponse acknowledge(const http::HttpRequest& request);
+  // metrics.ack_token, which /ack asks for: set at start and by a reload (main thread), read by
+  // the HTTP threads.
+  void set_ack_token(const std::string& token);
   http::HttpResponse status(const http::HttpRequest& request) const;
-  http::HttpResponse metrics_response() const;
+  http::HttpResponse metrics() const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -104,7 +105,9 @@ class Daemon {
   std::int64_t last_trend_save_ns_ = 0;
   static constexpr double kTrendSaveSeconds = 600.0;
   mutable std::mutex state_saved_mutex_;  // the main thread saves, the metrics thread reads
-  std::map<std::string, double> state_saved_unix_;
+  std::map<std::string, double> state_saved_unix_;  // by actuator, when its state was saved
+  mutable std::mutex ack_token_mutex_;
+  std::string ack_token_;
   realtime::CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};

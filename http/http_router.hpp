@@ -1,5 +1,6 @@
-// Routing and parameter checks for the daemon's HTTP endpoint, free of the transport and of the
-// daemon, so that they are unit-tested on their own (tests/http/http_target_test.cpp).
+// Routing by path and method for an HTTP endpoint: what it serves is the caller's table, so the
+// router knows nothing of the daemon (unit-tested in tests/http/http_target_test.cpp). The
+// service's own parameter checks are daemon/routes.hpp.
 #pragma once
 
 #include <functional>
@@ -21,22 +22,5 @@ struct HttpRoute {
 // The route for the request's path and method; a known path with another method is a 405
 // naming the allowed ones (Allow header), an unknown path a 404 listing the paths.
 HttpResponse route(std::span<const HttpRoute> routes, const HttpRequest& request);
-
-// POST /ack: no parameters acknowledges every actuator; otherwise exactly one `actuator=NAME`
-// with a non-empty NAME. Anything else (unknown, repeated or valueless parameters) is an error
-// response, and nothing is acknowledged.
-struct AckSelection {
-  std::string actuator;  // empty: all
-  std::optional<HttpResponse> error;
-};
-AckSelection ack_selection(const HttpRequest& request);
-
-// GET /status: JSON unless `format=text` or an Accept header that prefers text/plain; any other
-// parameter or format is an error response.
-struct StatusFormat {
-  bool text = false;
-  std::optional<HttpResponse> error;
-};
-StatusFormat status_format(const HttpRequest& request);
 
 }  // namespace leakmon::http

@@ -81,4 +81,11 @@ RequestTargetResult parse_request_target(std::string_view target) {
   return result;
 }
 
+const QueryParam* find_param(std::span<const QueryParam> params, std::string_view name) {
+  for (const auto& param : params) {
+    if (param.name == name) return &param;
+  }
+  return nullptr;
+}
+
 }  // namespace leakmon::http

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,5 +38,9 @@ std::optional<std::string> percent_decode(std::string_view text, bool plus_is_sp
 // are skipped (`a=1&&b=2`, a trailing `&`); a piece splits at its first `=`, so a value may hold
 // further `=`. Fragments (`#`) never belong in a request and are an error.
 RequestTargetResult parse_request_target(std::string_view target);
+
+// The first parameter named `name` (decoded), or nullptr. The one way a handler reads the query:
+// nothing decodes a query string twice.
+const QueryParam* find_param(std::span<const QueryParam> params, std::string_view name);
 
 }  // namespace leakmon::http

@@ -85,6 +85,9 @@ struct ActuatorStatus {
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
   std::uint64_t relearns = 0;             // how often a reload made the detector learn again
+  // Wall time [s since 1970] the learned state kept in the state directory was saved; NaN when
+  // none is. The service fills it: it is the one that saves (views/snapshot.hpp).
+  double learned_state_saved_unix = io::kNoValue;
 };
 
 using EventPublisher = std::function<void(const io::Event&)>;

@@ -1,17 +1,19 @@
-// The Prometheus text exposition format (version 0.0.4) as a small writer: one HELP and TYPE
-// header per metric family, samples with escaped label values, and histograms as cumulative
-// `_bucket{le=...}` series with `_sum` and `_count`. It only builds text; whoever serves it
-// (http/http_endpoint today) is someone else's business.
+// GET /metrics: the service's snapshot in the Prometheus text exposition format (version 0.0.4).
+// PrometheusText is the small writer (one HELP and TYPE header per metric family, samples with
+// escaped label values, histograms as cumulative `_bucket{le=...}` series with `_sum` and
+// `_count`); every family the daemon exports is declared once, with its name, help and type, in
+// metrics_text.cpp, as node_exporter's collectors declare theirs. It only builds text; serving it
+// is the transport's business.
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <span>
 #include <string>
 #include <string_view>
 
-#include "pipeline/actuator_monitor.hpp"
 #include "io/device_status.hpp"
+#include "pipeline/actuator_monitor.hpp"
+#include "views/snapshot.hpp"
 
 namespace leakmon::views {
 
@@ -21,9 +23,20 @@ std::string escape_label_value(std::string_view text);
 // A sample value: finite numbers in their shortest round-trip form, anything else "NaN".
 std::string metric_number(double value);
 
+enum class MetricType { counter, gauge, histogram };
+std::string_view to_string(MetricType type);
+
+// A metric family: its name, help text and type, declared once.
+struct MetricFamily {
+  std::string_view name;
+  std::string_view help;
+  MetricType type;
+};
+
 class PrometheusText {
  public:
-  // Starts a family: "# HELP name help" and "# TYPE name type" (counter, gauge, histogram).
+  // Starts a family: "# HELP name help" and "# TYPE name type".
+  void family(const MetricFamily& family);
   void family(std::string_view name, std::string_view help, std::string_view type);
 
   // One sample line. `labels` is the already formatted label list without braces (see label()),
@@ -31,6 +44,10 @@ class PrometheusText {
   void sample(std::string_view name, std::string_view labels, std::uint64_t value);
   void sample(std::string_view name, std::string_view labels, std::int64_t value);
   void sample(std::string_view name, std::string_view labels, double value);
+  template <typename Value>
+  void sample(const MetricFamily& family, std::string_view labels, Value value) {
+    sample(family.name, labels, value);
+  }
 
   // The series of one histogram: `upper_bounds` in increasing order with their cumulative
   // counts (`cumulative[i]` observations <= upper_bounds[i]), then le="+Inf" (= count), _sum and
@@ -55,10 +72,13 @@ void state_set(PrometheusText& out, std::string_view name, std::string_view labe
                io::DeviceStatus current);
 
 // The per-actuator families of /metrics (index, score, alarm, leak size with its 95 % half-width,
-// oil temperature, sensor status, learned state age). `state_saved_unix`: by actuator, the wall
-// time [s since 1970] the learned state kept in the state directory was saved (an actuator
-// without an entry has no saved state and gets no age sample); `now_unix` the present wall time.
+// oil temperature, sensor status, learned state age). An actuator whose learned state was never
+// saved (ActuatorStatus::learned_state_saved_unix NaN) gets no age sample; `now_unix` is the
+// present wall time.
 void actuator_metrics(PrometheusText& out, std::span<const pipeline::ActuatorStatus> actuators,
-                      const std::map<std::string, double>& state_saved_unix, double now_unix);
+                      double now_unix);
+
+// Everything /metrics answers.
+std::string metrics_text(const ServiceSnapshot& snapshot);
 
 }  // namespace leakmon::views

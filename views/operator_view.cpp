@@ -14,90 +14,21 @@
 #include <limits>
 #include <sstream>
 
-#include "capture/units.hpp"
 #include "config/yaml_reader.hpp"
-#include "daemon/daemon.hpp"
 #include "pipeline/event_log.hpp"
+#include "views/json_writer.hpp"
+#include "views/vocabulary.hpp"
 #include "views/web_assets.hpp"
-#include "io/event_json.hpp"
 
 namespace leakmon::views {
 namespace {
 
-double unix_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+// The wall time to the millisecond, the resolution the trend file keeps (trend_history.cpp).
+double unix_now_ms() {
+  const double now =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::round(now * 1e3) / 1e3;
 }
-
-using io::append_json_string;
-
-// JSON has no NaN: a value the daemon does not have yet is null. Seven digits are more than
-// any sensor resolves; times (unix seconds) keep milliseconds.
-void append_number(std::string& out, double value) {
-  if (std::isfinite(value)) {
-    fmt::format_to(std::back_inserter(out), "{:.7g}", value);
-  } else {
-    out += "null";
-  }
-}
-
-void append_time(std::string& out, double unix_time) {
-  if (std::isfinite(unix_time)) {
-    fmt::format_to(std::back_inserter(out), "{:.3f}", unix_time);
-  } else {
-    out += "null";
-  }
-}
-
-// "key": value pairs, comma-separated within one object.
-class JsonFields {
- public:
-  explicit JsonFields(std::string& out) : out_(out) { out_ += '{'; }
-  ~JsonFields() { out_ += '}'; }
-  JsonFields(const JsonFields&) = delete;
-  JsonFields& operator=(const JsonFields&) = delete;
-
-  std::string& key(std::string_view name) {
-    if (!first_) out_ += ',';
-    first_ = false;
-    append_json_string(out_, name);
-    out_ += ':';
-    return out_;
-  }
-  void string(std::string_view name, std::string_view value) {
-    append_json_string(key(name), value);
-  }
-  void number(std::string_view name, double value) { append_number(key(name), value); }
-  void time(std::string_view name, double value) { append_time(key(name), value); }
-  void integer(std::string_view name, std::uint64_t value) {
-    fmt::format_to(std::back_inserter(key(name)), "{}", value);
-  }
-  void boolean(std::string_view name, bool value) { key(name) += value ? "true" : "false"; }
-  // A column of the ring's points after `from`, e.g. the score of every point.
-  template <typename Ring, typename Value>
-  void column(std::string_view name, const Ring& ring, std::size_t from, Value value) {
-    std::string& out = key(name);
-    out += '[';
-    for (std::size_t i = from; i < ring.size(); ++i) {
-      if (i > from) out += ',';
-      append_number(out, value(ring[i]));
-    }
-    out += ']';
-  }
-  template <typename Ring>
-  void time_column(const Ring& ring, std::size_t from) {
-    std::string& out = key("time");
-    out += '[';
-    for (std::size_t i = from; i < ring.size(); ++i) {
-      if (i > from) out += ',';
-      append_time(out, ring[i].unix_time);
-    }
-    out += ']';
-  }
-
- private:
-  std::string& out_;
-  bool first_ = true;
-};
 
 // The first point of `ring` newer than `since` (points are in time order).
 template <typename Ring>
@@ -114,56 +45,40 @@ std::size_t first_after(const Ring& ring, double since) {
   return lo;
 }
 
-int hex_digit(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
 http::HttpResponse json_response(std::string body) {
   return {200, "application/json; charset=utf-8", std::move(body)};
 }
 
+http::HttpResponse bad_request(std::string body) {
+  return {400, "text/plain; charset=utf-8", std::move(body)};
+}
+
+// A trend column: the value of `column` of each of the ring's points after `from`.
+template <typename Ring, typename Column>
+void write_column(JsonWriter& json, std::string_view name, const Ring& ring, std::size_t from,
+                  const Column& column) {
+  json.begin_array(name);
+  for (std::size_t i = from; i < ring.size(); ++i) write_value(json, {}, column, ring[i]);
+  json.end_array();
+}
+
+template <typename Ring>
+void write_time_column(JsonWriter& json, const Ring& ring, std::size_t from) {
+  json.begin_array("time");
+  for (std::size_t i = from; i < ring.size(); ++i) json.number({}, ring[i].unix_time);
+  json.end_array();
+}
+
+// The column of `table` named `name` (renamed columns repeat it under their old name).
+template <typename Row>
+const Field<Row>& column_named(std::span<const Field<Row>> table, std::string_view name) {
+  for (const auto& field : table) {
+    if (field.name == name) return field;
+  }
+  throw std::logic_error("views/vocabulary: no trend column named " + std::string(name));
+}
+
 }  // namespace
-
-std::string query_value(std::string_view query, std::string_view key) {
-  while (!query.empty()) {
-    const auto amp = query.find('&');
-    const std::string_view pair = query.substr(0, amp);
-    query = amp == std::string_view::npos ? std::string_view{} : query.substr(amp + 1);
-    const auto eq = pair.find('=');
-    if (pair.substr(0, eq) != key) continue;
-    if (eq == std::string_view::npos) return {};
-    std::string value;
-    const std::string_view raw = pair.substr(eq + 1);
-    for (std::size_t i = 0; i < raw.size(); ++i) {
-      if (raw[i] == '+') {
-        value += ' ';
-      } else if (raw[i] == '%') {
-        if (i + 2 >= raw.size() || hex_digit(raw[i + 1]) < 0 || hex_digit(raw[i + 2]) < 0) {
-          return {};
-        }
-        value += static_cast<char>(hex_digit(raw[i + 1]) * 16 + hex_digit(raw[i + 2]));
-        i += 2;
-      } else {
-        value += raw[i];
-      }
-    }
-    return value;
-  }
-  return {};
-}
-
-bool same_token(std::string_view given, std::string_view expected) {
-  unsigned difference = given.size() == expected.size() ? 0u : 1u;
-  for (std::size_t i = 0; i < expected.size(); ++i) {
-    const char g = i < given.size() ? given[i] : '\0';
-    difference |= static_cast<unsigned>(static_cast<unsigned char>(g) ^
-                                        static_cast<unsigned char>(expected[i]));
-  }
-  return difference == 0;
-}
 
 void RecentEvents::add(const io::Event& event) {
   std::string line = to_json_line(event);
@@ -218,7 +133,7 @@ OperatorView::OperatorView(const pipeline::DaemonConfig& config,
       events_(std::make_shared<RecentEvents>(kRecentEvents)),
       history_(trend_capacity(config.metrics.trend_seconds, config.metrics.trend_interval_s),
                actuator_names(config), groups),
-      ack_token_(config.metrics.ack_token) {}
+      ack_token_required_(!config.metrics.ack_token.empty()) {}
 
 OperatorView::~OperatorView() {
   {
@@ -237,7 +152,7 @@ void OperatorView::set_source(SnapshotSource source) { source_ = std::move(sourc
 
 void OperatorView::start_sampling(SnapshotSource source) {
   set_source(std::move(source));
-  sample(unix_now());  // the page has a point at once
+  sample(unix_now_ms());  // the page has a point at once
   sampler_ = std::thread([this] { run_sampler(); });
 }
 
@@ -248,7 +163,7 @@ void OperatorView::run_sampler() {
   std::unique_lock lock(stop_mutex_);
   while (!stop_signal_.wait_until(lock, next, [this] { return stop_; })) {
     lock.unlock();
-    sample(unix_now());
+    sample(unix_now_ms());
     lock.lock();
     next += interval;
     // After a stall (suspend, debugger) start afresh instead of catching up in a burst.
@@ -266,9 +181,9 @@ void OperatorView::sample(double unix_time) {
   latest_time_ = unix_time;
 }
 
-void OperatorView::set_ack_token(const std::string& token) {
+void OperatorView::set_ack_token_required(bool required) {
   std::lock_guard lock(mutex_);
-  ack_token_ = token;
+  ack_token_required_ = required;
 }
 
 void OperatorView::save_history(const pipeline::StateStore& store) const {
@@ -371,156 +286,122 @@ std::string OperatorView::trend_json(double since) const {
   std::lock_guard lock(mutex_);
   std::string out;
   out.reserve(4096);
-  JsonFields root(out);
-  root.time("now", latest_time_);
-  root.number("interval_s", interval_s_);
-  root.integer("capacity", history_.capacity());
-  root.boolean("ack_token_required", !ack_token_.empty());
-  root.integer("samples_processed", latest_.samples_processed);
-  root.integer("events", latest_.events);
-  root.number("decision_latency_p99_us",
-              static_cast<double>(latest_.decision_latency_p99_ns) / 1e3);
+  JsonWriter json(out);
+  json.begin_object();
+  json.number("now", latest_time_);
+  json.number("interval_s", interval_s_);
+  json.integer("capacity", std::uint64_t{history_.capacity()});
+  json.boolean("ack_token_required", ack_token_required_);
+  write_service(json, latest_);
 
-  root.key("actuators") += '[';
-  bool first_actuator = true;
+  json.begin_array("actuators");
   for (const auto& a : latest_.actuators) {
-    if (!first_actuator) out += ',';
-    first_actuator = false;
-    JsonFields item(out);
-    item.string("name", a.name);
-    item.string("alarm", a.alarm);
-    item.string("detector", a.detector);
-    item.string("state", to_string(a.state));
-    item.boolean("learning", a.learning);
-    item.boolean("suspended", a.suspended);
-    item.boolean("detection_blind", a.detection_blind);
-    item.number("t", a.t);
-    item.number("index_p1", a.index_p1);
-    item.number("index_p2", a.index_p2);
-    item.number("score", a.score);
-    item.number("raise_threshold", a.raise_threshold);
-    item.number("clear_threshold", a.clear_threshold);
-    item.number("leak_lpm_per_mpa", units::lpm_per_mpa(a.leak_coefficient));
-    item.number("leak_lpm_per_mpa_ci95", units::lpm_per_mpa(a.leak_coefficient_ci));
-    item.number("p1", a.p1);
-    item.number("p2", a.p2);
-    item.number("oil_temperature", a.oil_temperature);
-    item.integer("decisions", a.decisions);
-    item.key("channels") += '[';
-    for (std::size_t i = 0; i < a.channels.size(); ++i) {
-      if (i > 0) out += ',';
-      const auto& c = a.channels[i];
-      JsonFields channel(out);
-      channel.string("channel", c.channel);
-      channel.string("status", io::to_string(c.status));
-      channel.string("fault", detect::to_string(c.fault));
-      channel.integer("spikes_rejected", c.spikes_rejected);
+    json.begin_object();
+    write_actuator(json, a);
+    // Renamed; kept for one release (views/vocabulary.cpp renamed_fields()).
+    json.number("index_p1", a.index_p1);
+    json.number("index_p2", a.index_p2);
+    json.number("p1", a.p1);
+    json.number("p2", a.p2);
+    json.number("oil_temperature", a.oil_temperature);
+    json.begin_array("channels");
+    for (const auto& c : a.channels) {
+      json.begin_object();
+      json.string("channel", c.channel);
+      json.string("status", io::to_string(c.status));
+      json.string("fault", detect::to_string(c.fault));  // "none" for none, as it was
+      json.integer("spikes_rejected", c.spikes_rejected);
+      json.end_object();
     }
-    out += ']';
+    json.end_array();
     const auto* series = history_.actuator(a.name);
-    item.key("trend");
     if (series == nullptr) {
-      out += "null";
-      continue;
+      json.null("trend");
+    } else {
+      const auto& ring = series->points;
+      const std::size_t from = first_after(ring, since);
+      json.begin_object("trend");
+      write_time_column(json, ring, from);
+      for (const auto& column : trend_columns())
+        write_column(json, column.name, ring, from, column);
+      // Renamed; kept for one release.
+      for (const auto& [old_name, name] :
+           {std::pair{"index_p1", "index_p1_pa"}, std::pair{"index_p2", "index_p2_pa"},
+            std::pair{"p1", "p1_pa"}, std::pair{"p2", "p2_pa"},
+            std::pair{"oil_temperature", "oil_temperature_c"},
+            std::pair{"alarm", "alarm_state_code"}}) {
+        write_column(json, old_name, ring, from, column_named(trend_columns(), name));
+      }
+      json.end_object();
     }
-    const auto& ring = series->points;
-    const std::size_t from = first_after(ring, since);
-    JsonFields trend(out);
-    trend.time_column(ring, from);
-    trend.column("index_p1", ring, from, [](const TrendPoint& p) { return p.index_p1; });
-    trend.column("index_p2", ring, from, [](const TrendPoint& p) { return p.index_p2; });
-    trend.column("score", ring, from, [](const TrendPoint& p) { return p.score; });
-    trend.column("raise_threshold", ring, from,
-                 [](const TrendPoint& p) { return p.raise_threshold; });
-    trend.column("leak_lpm_per_mpa", ring, from,
-                 [](const TrendPoint& p) { return p.leak_lpm_per_mpa; });
-    trend.column("leak_lpm_per_mpa_ci95", ring, from,
-                 [](const TrendPoint& p) { return p.leak_lpm_per_mpa_ci95; });
-    trend.column("p1", ring, from, [](const TrendPoint& p) { return p.p1; });
-    trend.column("p2", ring, from, [](const TrendPoint& p) { return p.p2; });
-    trend.column("oil_temperature", ring, from,
-                 [](const TrendPoint& p) { return p.oil_temperature; });
-    trend.column("alarm", ring, from,
-                 [](const TrendPoint& p) { return static_cast<double>(p.alarm); });
+    json.end_object();
   }
-  out += ']';
+  json.end_array();
 
-  root.key("groups") += '[';
-  bool first_group = true;
+  json.begin_array("groups");
   for (const auto& g : latest_.groups) {
-    if (!first_group) out += ',';
-    first_group = false;
-    JsonFields item(out);
-    item.string("name", g.group);
-    item.boolean("realtime", g.realtime);
-    item.integer("cycles", g.cycles);
-    item.integer("overruns", g.overruns);
-    item.integer("missed_cycles", g.missed_cycles);
-    item.integer("ring_drops", g.ring_drops);
-    item.integer("ring_high_water", g.ring_high_water);
-    item.integer("ring_capacity", g.ring_capacity);
-    item.number("latency_mean_us", g.latency_count == 0
-                                       ? NAN
-                                       : static_cast<double>(g.latency_sum_ns) /
-                                             static_cast<double>(g.latency_count) / 1e3);
-    item.number("latency_max_us", static_cast<double>(g.latency_max_ns) / 1e3);
-    item.number("latency_p99_us", static_cast<double>(g.latency_p99_ns) / 1e3);
-    const auto* series = history_.group(g.group);
-    item.key("trend");
+    json.begin_object();
+    write_group(json, g);
+    // Renamed; kept for one release.
+    json.number("latency_mean_us", g.wakeup_latency.mean_us());
+    json.number("latency_max_us", g.wakeup_latency.max_us());
+    json.number("latency_p99_us", g.wakeup_latency.p99_us());
+    const auto* series = history_.group(g.name);
     if (series == nullptr) {
-      out += "null";
-      continue;
+      json.null("trend");
+    } else {
+      const auto& ring = series->points;
+      const std::size_t from = first_after(ring, since);
+      json.begin_object("trend");
+      write_time_column(json, ring, from);
+      for (const auto& column : loop_trend_columns()) {
+        write_column(json, column.name, ring, from, column);
+      }
+      write_column(json, "latency_mean_us", ring, from,
+                   column_named(loop_trend_columns(), "wakeup_latency_mean_us"));
+      json.end_object();
     }
-    const auto& ring = series->points;
-    const std::size_t from = first_after(ring, since);
-    JsonFields trend(out);
-    trend.time_column(ring, from);
-    trend.column("latency_mean_us", ring, from,
-                 [](const LoopPoint& p) { return p.latency_mean_us; });
-    trend.column("overruns", ring, from,
-                 [](const LoopPoint& p) { return static_cast<double>(p.overruns); });
+    json.end_object();
   }
-  out += ']';
+  json.end_array();
+
+  json.begin_array("drivers");
+  for (const auto& d : latest_.drivers) {
+    json.begin_object();
+    write_driver(json, d);
+    json.end_object();
+  }
+  json.end_array();
+  json.end_object();
   return out;
 }
 
 std::optional<http::HttpResponse> OperatorView::handle(const http::HttpRequest& request) const {
-  if (request.path == "/ack") {
-    std::string token;
-    {
-      std::lock_guard lock(mutex_);
-      token = ack_token_;
-    }
-    // The token as a query parameter (the page, `leakmon ack`) or as a bearer credential.
-    constexpr std::string_view kBearer = "Bearer ";
-    const std::string_view authorization = request.authorization;
-    const bool bearer_ok = authorization.substr(0, kBearer.size()) == kBearer &&
-                           same_token(authorization.substr(kBearer.size()), token);
-    if (token.empty() || bearer_ok || same_token(query_value(request.query, "token"), token)) {
-      return std::nullopt;  // the daemon acknowledges
-    }
-    return http::HttpResponse{401, "text/plain; charset=utf-8",
-                              "acknowledging needs the token of metrics.ack_token: POST "
-                              "/ack?actuator=NAME&token=TOKEN\n"};
-  }
   if (request.method != "GET" && request.method != "HEAD") return std::nullopt;
+  // Parameters come decoded from the transport (http/http_target.hpp); the first of a repeated
+  // one counts, and others are ignored, as a browser's cache-busting parameter may be.
   if (request.path == "/api/trend") {
-    const std::string since = query_value(request.query, "since");
-    char* end = nullptr;
-    double value = since.empty() ? 0.0 : std::strtod(since.c_str(), &end);
-    if (!since.empty() && (end == nullptr || *end != '\0' || !std::isfinite(value))) {
-      return http::HttpResponse{400, "text/plain; charset=utf-8",
-                                fmt::format("since: '{}' is not a unix time in seconds\n", since)};
+    const http::QueryParam* since = http::find_param(request.params, "since");
+    double value = 0.0;
+    if (since != nullptr && !since->value.empty()) {
+      char* end = nullptr;
+      value = std::strtod(since->value.c_str(), &end);
+      if (end == nullptr || *end != '\0' || !std::isfinite(value)) {
+        return bad_request(
+            fmt::format("since: '{}' is not a unix time in seconds\n", since->value));
+      }
     }
     return json_response(trend_json(value));
   }
   if (request.path == "/api/events") {
-    const std::string after = query_value(request.query, "after");
-    char* end = nullptr;
-    const unsigned long long value = after.empty() ? 0 : std::strtoull(after.c_str(), &end, 10);
-    if (!after.empty() && (end == nullptr || *end != '\0')) {
-      return http::HttpResponse{400, "text/plain; charset=utf-8",
-                                fmt::format("after: '{}' is not an event number\n", after)};
+    const http::QueryParam* after = http::find_param(request.params, "after");
+    unsigned long long value = 0;
+    if (after != nullptr && !after->value.empty()) {
+      char* end = nullptr;
+      value = std::strtoull(after->value.c_str(), &end, 10);
+      if (end == nullptr || *end != '\0') {
+        return bad_request(fmt::format("after: '{}' is not an event number\n", after->value));
+      }
     }
     return json_response(events_->json_after(value));
   }
@@ -542,25 +423,4 @@ std::optional<http::HttpResponse> OperatorView::handle(const http::HttpRequest& 
   return std::nullopt;
 }
 
-// The daemon's side of the sampling: what /metrics reads, into `out` without allocating once
-// `out` has the daemon's shape (the groups are fixed; a reload may add actuators).
 }  // namespace leakmon::views
-
-// The service's side, until it fills a snapshot the views format.
-namespace leakmon::daemon {
-using namespace leakmon::views;
-void Daemon::fill_view_snapshot(ViewSnapshot& out) const {
-  worker_->status_into(out.actuators);
-  out.groups.resize(groups_.size());
-  for (std::size_t i = 0; i < groups_.size(); ++i) {
-    const Group& g = *groups_[i];
-    read_loop_health(out.groups[i], g.config.name, g.loop->counters(), g.ring->capacity(),
-                     g.realtime.fifo);
-  }
-  out.samples_processed = worker_->samples_processed();
-  out.events = worker_->events_published();
-  out.decision_latency_p99_ns = worker_->decision_latency().quantile_ns(0.99);
-}
-}  // namespace leakmon::daemon
-
-namespace leakmon::views {}  // namespace leakmon::views

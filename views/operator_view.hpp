@@ -1,12 +1,12 @@
 // The operator's live page on the daemon's HTTP endpoint (FORMATS.md "Operator view and
 // fleet"): `GET /` and its static assets (views/web/ and third_party/uplot/, compiled into the
-// binary), `GET /api/trend?since=UNIX` (the trend history and the current status as JSON),
-// `GET /api/events?after=SEQ` (the newest events), and the token check of `POST /ack`.
+// binary), `GET /api/trend?since=UNIX` (the trend history and the service's snapshot as JSON,
+// in the vocabulary of /status) and `GET /api/events?after=SEQ` (the newest events).
 //
-// A sampler thread of normal priority reads the daemon's status snapshot every
-// metrics.trend_interval_s into a preallocated ViewSnapshot and appends it to the TrendHistory;
-// neither allocates once warm. The real-time loops are never touched; the worker's mutex is
-// taken for the snapshot, as a /metrics scrape does.
+// A sampler thread of normal priority has the service fill a ServiceSnapshot
+// (views/snapshot.hpp) every metrics.trend_interval_s and appends it to the TrendHistory; the
+// snapshot is reused, and recording a point allocates nothing. The real-time loops are never
+// touched; the worker's mutex is taken for the snapshot, as a /metrics scrape does.
 #pragma once
 
 #include <condition_variable>
@@ -20,11 +20,12 @@
 #include <string_view>
 #include <thread>
 
-#include "pipeline/config.hpp"
 #include "http/http_endpoint.hpp"
-#include "pipeline/state_store.hpp"
-#include "views/trend_history.hpp"
 #include "io/event.hpp"
+#include "pipeline/config.hpp"
+#include "pipeline/state_store.hpp"
+#include "views/snapshot.hpp"
+#include "views/trend_history.hpp"
 
 namespace leakmon::views {
 
@@ -46,16 +47,9 @@ class RecentEvents {
   std::uint64_t next_ = 1;
 };
 
-// The decoded value of `key` in a query string `a=1&b=2` ('+' and %XX decoded); empty when
-// absent or malformed.
-std::string query_value(std::string_view query, std::string_view key);
-
-// Constant-time comparison, so the time /ack takes does not reveal how much of a token matched.
-bool same_token(std::string_view given, std::string_view expected);
-
 class OperatorView {
  public:
-  using SnapshotSource = std::function<void(ViewSnapshot&)>;
+  using SnapshotSource = std::function<void(ServiceSnapshot&)>;
   static constexpr std::size_t kRecentEvents = 100;
 
   // Allocates the trend history for the configuration's actuators and `groups`.
@@ -69,13 +63,15 @@ class OperatorView {
   std::unique_ptr<io::EventSink> event_sink() const;
   // Where sample() reads from, without starting the thread (tests).
   void set_source(SnapshotSource source);
-  // Starts the sampler thread; `source` fills a snapshot in place (Daemon::fill_view_snapshot).
+  // Starts the sampler thread; `source` fills a snapshot in place (Daemon::fill_snapshot). The
+  // sampler stamps its points to the millisecond, the trend file's resolution.
   void start_sampling(SnapshotSource source);
-  // One sample now (the sampler thread's step; tests call it directly). Allocates nothing once
-  // the snapshot is warm.
+  // One sample now (the sampler thread's step; tests call it directly). Allocates nothing beyond
+  // what the source does once the snapshot is warm.
   void sample(double unix_time);
-  // A reload may change the token.
-  void set_ack_token(const std::string& token);
+  // Whether POST /ack asks for metrics.ack_token (the page then shows a token field); a reload
+  // may change it. The service checks the token.
+  void set_ack_token_required(bool required);
 
   // The page's memory across a restart. save_history() writes every actuator's trend into
   // `store`'s directory (atomically, throws std::runtime_error naming the file);
@@ -88,8 +84,7 @@ class OperatorView {
   // skipped. Returns how many were taken.
   std::size_t restore_events(const std::string& event_log);
 
-  // The page, its assets and its data; a 401 for /ack without the configured token; nullopt
-  // for everything else (the daemon's own routes).
+  // The page, its assets and its data; nullopt for everything else (the service's own routes).
   std::optional<http::HttpResponse> handle(const http::HttpRequest& request) const;
 
   // JSON of /api/trend: points after `since` (unix seconds) and the newest status.
@@ -102,13 +97,13 @@ class OperatorView {
   double interval_s_;
   std::shared_ptr<RecentEvents> events_;
   SnapshotSource source_;
-  ViewSnapshot scratch_;  // the sampler's, filled outside the lock
+  ServiceSnapshot scratch_;  // the sampler's, filled outside the lock
 
   mutable std::mutex mutex_;  // guards everything below
   TrendHistory history_;
-  ViewSnapshot latest_;
+  ServiceSnapshot latest_;
   double latest_time_ = 0.0;
-  std::string ack_token_;
+  bool ack_token_required_ = false;
 
   std::mutex stop_mutex_;
   std::condition_variable stop_signal_;

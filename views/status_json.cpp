@@ -6,108 +6,91 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "capture/units.hpp"
-#include "daemon/daemon.hpp"
-#include "io/event_json.hpp"
+#include "views/json_writer.hpp"
+#include "views/vocabulary.hpp"
 
 namespace leakmon::views {
-namespace {
 
-using io::json_string;
-
-std::string flag(bool on) { return on ? "true" : "false"; }
-
-}  // namespace
-
-std::string json_number(double value) {
-  return std::isfinite(value) ? fmt::format("{}", value) : "null";
-}
-
-}  // namespace leakmon::views
-
-// The service's side, until it fills a snapshot the views format.
-namespace leakmon::daemon {
-using namespace leakmon::views;
-std::string Daemon::status_json() const {
-  const std::int64_t now = realtime::monotonic_now_ns();
-  std::string out = "{";
-  out += fmt::format("\"version\":{},\"uptime_s\":{},\"config\":{},", json_string(LEAKMON_VERSION),
-                     json_number(static_cast<double>(now - started_ns_) / 1e9),
-                     json_string(config_path_));
-  out += fmt::format("\"reload\":{{\"ok\":{},\"reloads\":{},\"failures\":{},\"last_unix\":{}}},",
-                     flag(last_reload_ok_.load()), reloads_.load(), reload_failures_.load(),
-                     last_reload_unix_.load());
-  out += "\"groups\":[";
-  for (std::size_t i = 0; i < groups_.size(); ++i) {
-    const auto& g = *groups_[i];
-    const auto& c = g.loop->counters();
-    const std::int64_t last = c.last_cycle_ns.load();
-    out += fmt::format(
-        "{}{{\"name\":{},\"cycles\":{},\"overruns\":{},\"missed_cycles\":{},\"ring_drops\":{},"
-        "\"ring_high_water\":{},\"ring_capacity\":{},\"realtime\":{},\"wakeup_latency_us\":{{"
-        "\"mean\":{},\"max\":{}}},\"last_cycle_age_s\":{},\"ended\":{}}}",
-        i == 0 ? "" : ",", json_string(g.config.name), c.cycles.load(), c.overruns.load(),
-        c.missed_cycles.load(), c.ring_drops.load(), c.ring_high_water.load(), g.ring->capacity(),
-        flag(g.realtime.fifo),
-        json_number(c.cycles.load() == 0 ? NAN : c.wakeup_latency.mean_ns() / 1e3),
-        json_number(c.cycles.load() == 0 ? NAN
-                                         : static_cast<double>(c.wakeup_latency.max_ns()) / 1e3),
-        json_number(last == 0 ? NAN : static_cast<double>(now - last) / 1e9),
-        flag(c.end_of_stream.load()));
+std::string status_json(const ServiceSnapshot& snapshot) {
+  std::string out;
+  out.reserve(2048);
+  JsonWriter json(out);
+  json.begin_object();
+  write_service(json, snapshot);
+  json.begin_array("groups");
+  for (const auto& group : snapshot.groups) {
+    json.begin_object();
+    write_group(json, group);
+    // Renamed; kept for one release (views/vocabulary.cpp renamed_fields()).
+    json.begin_object("wakeup_latency_us");
+    json.number("mean", group.wakeup_latency.mean_us());
+    json.number("max", group.wakeup_latency.max_us());
+    json.end_object();
+    json.end_object();
   }
-  out += "],\"drivers\":[";
-  for (std::size_t i = 0; i < drivers_.size(); ++i) {
-    const auto health = drivers_[i]->health();
-    out += fmt::format(
-        "{}{{\"name\":{},\"status\":{},\"detail\":{},\"last_error\":{},\"errors\":{},"
-        "\"reconnects\":{},\"stale_values\":{}}}",
-        i == 0 ? "" : ",", json_string(drivers_[i]->name()),
-        json_string(io::to_string(health.status)), json_string(health.detail),
-        health.last_error.empty() ? "null" : json_string(health.last_error), health.errors,
-        health.reconnects, health.stale_values);
+  json.end_array();
+  json.begin_array("drivers");
+  for (const auto& driver : snapshot.drivers) {
+    json.begin_object();
+    write_driver(json, driver);
+    json.end_object();
   }
-  out += "],\"actuators\":[";
-  const auto actuators = worker_->status();
-  for (std::size_t i = 0; i < actuators.size(); ++i) {
-    const auto& a = actuators[i];
-    const char* state = a.state != pipeline::AlarmState::normal ? "alarm"
-                        : a.learning                            ? "learning"
-                                                                : "monitoring";
-    out += fmt::format(
-        "{}{{\"name\":{},\"detector\":{},\"state\":\"{}\",\"learning_seconds_left\":{},"
-        "\"t\":{},\"index_pa\":{{\"p1\":{},\"p2\":{}}},\"score\":{},\"threshold\":{{\"raise\":{},"
-        "\"clear\":{}}},\"baseline_pa\":{},\"leak_lpm_per_mpa\":{{\"estimate\":{},\"ci95\":{}}},"
-        "\"oil_temperature_c\":{},\"alarms\":[{{\"name\":{},\"state\":{}}}],\"suspended\":{},"
-        "\"mode_visibility\":{},\"detection_blind\":{},\"decisions\":{},\"gap_samples\":{},"
-        "\"sensors\":[",
-        i == 0 ? "" : ",", json_string(a.name), json_string(a.detector), state,
-        json_number(a.learning ? a.learning_seconds_left : NAN), json_number(a.t),
-        json_number(a.index_p1), json_number(a.index_p2), json_number(a.score),
-        json_number(a.raise_threshold), json_number(a.clear_threshold), json_number(a.baseline),
-        json_number(units::lpm_per_mpa(a.leak_coefficient)),
-        json_number(units::lpm_per_mpa(a.leak_coefficient_ci)), json_number(a.oil_temperature),
-        json_string(a.alarm), json_string(to_string(a.state)), flag(a.suspended),
-        json_number(a.mode_visibility), flag(a.detection_blind), a.decisions, a.gap_samples);
-    for (std::size_t k = 0; k < a.channels.size(); ++k) {
-      const auto& c = a.channels[k];
-      out += fmt::format(
-          "{}{{\"channel\":{},\"status\":{},\"fault\":{},\"spikes_rejected\":{}}}",
-          k == 0 ? "" : ",", json_string(c.channel), json_string(io::to_string(c.status)),
-          c.fault == detect::SensorFault::none ? "null" : json_string(detect::to_string(c.fault)),
-          c.spikes_rejected);
-    }
-    out += "]}";
+  json.end_array();
+  json.begin_array("actuators");
+  for (const auto& actuator : snapshot.actuators) {
+    json.begin_object();
+    write_actuator(json, actuator);
+    // Renamed; kept for one release (views/vocabulary.cpp renamed_fields()).
+    json.begin_object("index_pa");
+    json.number("p1", actuator.index_p1);
+    json.number("p2", actuator.index_p2);
+    json.end_object();
+    json.begin_object("threshold");
+    json.number("raise", actuator.raise_threshold);
+    json.number("clear", actuator.clear_threshold);
+    json.end_object();
+    json.begin_array("alarms");
+    json.begin_object();
+    json.string("name", actuator.alarm);
+    json.string("state", pipeline::to_string(actuator.state));
+    json.end_object();
+    json.end_array();
+    json.end_object();
   }
-  out += "]}\n";
+  json.end_array();
+  json.end_object();
+  out += '\n';
   return out;
 }
-std::string Daemon::status_text() const { return views::status_text_from_json(status_json()); }
 
-}  // namespace leakmon::daemon
-
-namespace leakmon::views {
+std::string features_json(const ServiceSnapshot& snapshot,
+                          const pipeline::ActuatorStatus& actuator) {
+  std::string out;
+  JsonWriter json(out, JsonWriter::Style::message);
+  json.begin_object();
+  write_fields(json, actuator_fields(), actuator, {"t"});
+  json.string("actuator", actuator.name);
+  write_fields(json, actuator_fields(), actuator,
+               {"index_p1_pa", "score", "leak_lpm_per_mpa", "leak_lpm_per_mpa_ci95", "alarm_state",
+                "learning"});
+  // Renamed; kept for one release: the p1 index in kPa (views/vocabulary.cpp renamed_fields()).
+  json.number("index", actuator.index_p1 / 1e3);
+  json.number("unix_time", snapshot.unix_time);
+  json.end_object();
+  return out;
+}
 
 namespace {
+
+// The member `name` of `node`, or the member the previous release called it.
+YAML::Node member(const YAML::Node& node, const char* name, const char* old_name = nullptr,
+                  const char* old_member = nullptr) {
+  if (node[name]) return node[name];
+  if (old_name != nullptr && node[old_name]) {
+    return old_member != nullptr ? node[old_name][old_member] : node[old_name];
+  }
+  return YAML::Node();
+}
 
 // A number from the document, NaN for null (or absent).
 double number(const YAML::Node& node) {
@@ -154,10 +137,11 @@ std::string status_text_from_json(std::string_view json) {
           "group {}: {} cycles, wake-up latency avg {} max {}, {} overruns, {} missed, {} ring "
           "drops (high water {}/{}), {}{}\n",
           text(g["name"]), text(g["cycles"]),
-          maybe(number(g["wakeup_latency_us"]["mean"]), " us", 1),
-          maybe(number(g["wakeup_latency_us"]["max"]), " us", 1), text(g["overruns"]),
-          text(g["missed_cycles"]), text(g["ring_drops"]), text(g["ring_high_water"]),
-          text(g["ring_capacity"]), g["realtime"].as<bool>() ? "SCHED_FIFO" : "normal scheduling",
+          maybe(number(member(g, "wakeup_latency_mean_us", "wakeup_latency_us", "mean")), " us", 1),
+          maybe(number(member(g, "wakeup_latency_max_us", "wakeup_latency_us", "max")), " us", 1),
+          text(g["overruns"]), text(g["missed_cycles"]), text(g["ring_drops"]),
+          text(g["ring_high_water"]), text(g["ring_capacity"]),
+          g["realtime"].as<bool>() ? "SCHED_FIFO" : "normal scheduling",
           g["ended"].as<bool>() ? ", source ended" : "");
     }
     for (const auto& d : doc["drivers"]) {
@@ -178,18 +162,26 @@ std::string status_text_from_json(std::string_view json) {
       }
       out += fmt::format("actuator {}: {}, detector {}, t {}\n", text(a["name"]), what,
                          text(a["detector"]), maybe(number(a["t"]), " s", 2));
-      for (const auto& alarm : a["alarms"]) {
-        out += fmt::format("  alarm {}: {}\n", text(alarm["name"]), text(alarm["state"]));
+      if (a["alarm_state"]) {
+        out += fmt::format("  alarm {}: {}\n", text(a["alarm"]), text(a["alarm_state"]));
+      } else {
+        for (const auto& alarm : a["alarms"]) {
+          out += fmt::format("  alarm {}: {}\n", text(alarm["name"]), text(alarm["state"]));
+        }
       }
       out +=
           fmt::format("  index p1 {}, p2 {}; score {} (raises at {}, clears at {}); baseline {}\n",
-                      maybe(number(a["index_pa"]["p1"]) / 1e3, " kPa", 2),
-                      maybe(number(a["index_pa"]["p2"]) / 1e3, " kPa", 2),
-                      significant(number(a["score"])), significant(number(a["threshold"]["raise"])),
-                      significant(number(a["threshold"]["clear"])),
+                      maybe(number(member(a, "index_p1_pa", "index_pa", "p1")) / 1e3, " kPa", 2),
+                      maybe(number(member(a, "index_p2_pa", "index_pa", "p2")) / 1e3, " kPa", 2),
+                      significant(number(a["score"])),
+                      significant(number(member(a, "raise_threshold", "threshold", "raise"))),
+                      significant(number(member(a, "clear_threshold", "threshold", "clear"))),
                       maybe(number(a["baseline_pa"]) / 1e3, " kPa", 2));
-      const double leak = number(a["leak_lpm_per_mpa"]["estimate"]);
-      const double ci = number(a["leak_lpm_per_mpa"]["ci95"]);
+      // The previous release's leak_lpm_per_mpa was {estimate, ci95}.
+      const YAML::Node leak_node = a["leak_lpm_per_mpa"];
+      const bool old_leak = leak_node && leak_node.IsMap();
+      const double leak = number(old_leak ? leak_node["estimate"] : leak_node);
+      const double ci = number(old_leak ? leak_node["ci95"] : a["leak_lpm_per_mpa_ci95"]);
       out += fmt::format("  leak estimate {}\n",
                          !std::isfinite(leak) ? std::string("n/a")
                          : std::isfinite(ci)  ? fmt::format("{:.3f} +/- {:.3f} l/min/MPa", leak, ci)

@@ -175,23 +175,6 @@ std::vector<TrendPoint> decode_trend(std::string_view text) {
   return points;
 }
 
-void read_loop_health(LoopHealth& out, const std::string& group,
-                      const realtime::LoopCounters& counters, std::size_t ring_capacity,
-                      bool realtime) {
-  out.group = group;
-  out.realtime = realtime;
-  out.cycles = counters.cycles.load(std::memory_order_relaxed);
-  out.overruns = counters.overruns.load(std::memory_order_relaxed);
-  out.missed_cycles = counters.missed_cycles.load(std::memory_order_relaxed);
-  out.ring_drops = counters.ring_drops.load(std::memory_order_relaxed);
-  out.ring_high_water = counters.ring_high_water.load(std::memory_order_relaxed);
-  out.ring_capacity = ring_capacity;
-  out.latency_count = counters.wakeup_latency.count();
-  out.latency_sum_ns = counters.wakeup_latency.sum_ns();
-  out.latency_max_ns = counters.wakeup_latency.max_ns();
-  out.latency_p99_ns = counters.wakeup_latency.quantile_ns(0.99);
-}
-
 std::size_t trend_capacity(double seconds, double interval_s) {
   return std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(seconds / interval_s)));
 }
@@ -232,7 +215,7 @@ const TrendHistory::GroupSeries* TrendHistory::group(const std::string& name) co
   return nullptr;
 }
 
-void TrendHistory::record(double unix_time, const ViewSnapshot& snapshot) {
+void TrendHistory::record(double unix_time, const ServiceSnapshot& snapshot) {
   for (const auto& status : snapshot.actuators) {
     auto it = std::find_if(actuators_.begin(), actuators_.end(),
                            [&](const ActuatorSeries& s) { return s.name == status.name; });
@@ -242,26 +225,27 @@ void TrendHistory::record(double unix_time, const ViewSnapshot& snapshot) {
     }
     it->points.push(point_of(unix_time, status));
   }
-  for (const auto& health : snapshot.groups) {
+  for (const auto& group : snapshot.groups) {
     auto it = std::find_if(groups_.begin(), groups_.end(),
-                           [&](const GroupSeries& s) { return s.name == health.group; });
+                           [&](const GroupSeries& s) { return s.name == group.name; });
+    const LatencySummary& latency = group.wakeup_latency;
     if (it == groups_.end()) {
-      groups_.push_back({health.group, FixedRing<LoopPoint>(capacity_)});
+      groups_.push_back({group.name, FixedRing<LoopPoint>(capacity_)});
       it = groups_.end() - 1;
-      it->last_count = health.latency_count;
-      it->last_sum_ns = health.latency_sum_ns;
+      it->last_count = latency.count;
+      it->last_sum_ns = latency.sum_ns;
     }
     LoopPoint p;
     p.unix_time = unix_time;
-    const std::uint64_t cycles = health.latency_count - it->last_count;
+    const std::uint64_t cycles = latency.count - it->last_count;
     p.latency_mean_us = cycles == 0 ? kNaN
-                                    : static_cast<double>(health.latency_sum_ns - it->last_sum_ns) /
+                                    : static_cast<double>(latency.sum_ns - it->last_sum_ns) /
                                           static_cast<double>(cycles) / 1e3;
-    p.overruns = health.overruns;
-    p.ring_drops = health.ring_drops;
+    p.overruns = group.overruns;
+    p.ring_drops = group.ring_drops;
     it->points.push(p);
-    it->last_count = health.latency_count;
-    it->last_sum_ns = health.latency_sum_ns;
+    it->last_count = latency.count;
+    it->last_sum_ns = latency.sum_ns;
   }
 }
 

@@ -13,37 +13,9 @@
 #include <string_view>
 #include <vector>
 
-#include "realtime/acquisition_loop.hpp"
-#include "pipeline/actuator_monitor.hpp"
+#include "views/snapshot.hpp"
 
 namespace leakmon::views {
-
-// One sampling group's loop health as the page shows it.
-struct LoopHealth {
-  std::string group;
-  bool realtime = false;  // SCHED_FIFO
-  std::uint64_t cycles = 0, overruns = 0, missed_cycles = 0, ring_drops = 0;
-  std::uint64_t ring_high_water = 0, ring_capacity = 0;
-  // The wake-up latency histogram's totals (realtime/latency_histogram.hpp), since the start.
-  std::uint64_t latency_count = 0;
-  std::int64_t latency_sum_ns = 0, latency_max_ns = 0, latency_p99_ns = 0;
-};
-
-// A group's health from its loop's counters, into `out` without allocating (the name is
-// assigned in place: the same name reuses its storage).
-void read_loop_health(LoopHealth& out, const std::string& group,
-                      const realtime::LoopCounters& counters, std::size_t ring_capacity,
-                      bool realtime);
-
-// What the sampler reads each interval: the actuators' status (as /metrics reads it) and the
-// loops' health. Filled in place, so that a warm snapshot is refilled without allocating.
-struct ViewSnapshot {
-  std::vector<pipeline::ActuatorStatus> actuators;
-  std::vector<LoopHealth> groups;
-  std::uint64_t samples_processed = 0;
-  std::uint64_t events = 0;
-  std::int64_t decision_latency_p99_ns = 0;
-};
 
 // One actuator at one instant. Leak sizes in l/min/MPa (at 40 degC when the oil temperature is
 // acquired), pressures and the index in Pa.
@@ -54,7 +26,7 @@ struct TrendPoint {
   double leak_lpm_per_mpa = 0.0, leak_lpm_per_mpa_ci95 = 0.0;
   double p1 = 0.0, p2 = 0.0;
   double oil_temperature = 0.0;
-  std::uint8_t alarm = 0;  // AlarmState
+  std::uint8_t alarm = 0;  // pipeline::AlarmState
   bool learning = false;
   bool suspended = false;
   // io::DeviceStatus of the checked channels (p1, p2, x, in ActuatorStatus::channels order);
@@ -102,7 +74,7 @@ class TrendHistory {
 
   // Appends one point per actuator and group of `snapshot`. Allocates nothing for the names
   // given at construction; an actuator added by a reload gets its ring here, once.
-  void record(double unix_time, const ViewSnapshot& snapshot);
+  void record(double unix_time, const ServiceSnapshot& snapshot);
 
   struct ActuatorSeries {
     std::string name;

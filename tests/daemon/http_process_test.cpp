@@ -32,13 +32,13 @@ std::string header_value(const http::HttpResponse& response, const std::string& 
 }
 
 // The alarm state of the only actuator, from the JSON status (the text between the quotes
-// after "alarms":[{"name":"...","state":").
+// after "alarm_state":").
 std::string alarm_state(int port) {
   const std::string body = http::http_request("127.0.0.1", port, "GET", "/status").body;
-  const auto alarms = body.find("\"alarms\":[");
-  const auto key = body.find("\"state\":\"", alarms);
-  if (alarms == std::string::npos || key == std::string::npos) return "(no status)";
-  const auto start = key + 9;
+  const std::string_view key = "\"alarm_state\":\"";
+  const auto at = body.find(key);
+  if (at == std::string::npos) return "(no status)";
+  const auto start = at + key.size();
   return body.substr(start, body.find('"', start) - start);
 }
 

@@ -1,14 +1,11 @@
-// The request-target parser and the router checks, on the inputs issue 15 found answered wrongly
-// (`/ack?foo=bar`, `?actuator`, `?actuator=`, `?%%%%`, HEAD and POST on /metrics) and on the
-// encodings a client may legitimately use.
+// The request-target parser and the router, on the inputs issue 15 found answered wrongly
+// (`?%%%%`, HEAD and POST on /metrics) and on the encodings a client may legitimately use. The
+// service's parameter checks (`/ack?foo=bar`, `?actuator`, `?actuator=`) are
+// tests/daemon/routes_test.cpp's.
 #include <gtest/gtest.h>
-
-#include <cmath>
 
 #include "http/http_router.hpp"
 #include "http/http_target.hpp"
-#include "views/status_json.hpp"
-#include "io/event_json.hpp"
 
 namespace leakmon::http {
 namespace {
@@ -106,73 +103,6 @@ TEST(HttpRouter, RoutesByPathAndMethodWith405AndAllow) {
   EXPECT_EQ(missing.status, 404);
   EXPECT_NE(missing.body.find("GET /metrics"), std::string::npos);
   EXPECT_EQ(served, 2);  // nothing was served for the errors
-}
-
-TEST(HttpRouter, AckIsStrictAboutItsParameters) {
-  EXPECT_FALSE(ack_selection(request("POST", "/ack")).error);
-  EXPECT_EQ(ack_selection(request("POST", "/ack")).actuator, "");  // all
-  const AckSelection one = ack_selection(request("POST", "/ack?actuator=left%20boom"));
-  EXPECT_FALSE(one.error);
-  EXPECT_EQ(one.actuator, "left boom");
-  for (const char* bad :
-       {"/ack?foo=bar", "/ack?actuator", "/ack?actuator=", "/ack?actuatr=cyl",
-        "/ack?actuator=cyl&actuator=cyl", "/ack?actuator=cyl&all=1", "/ack?Actuator=cyl"}) {
-    const AckSelection selection = ack_selection(request("POST", bad));
-    ASSERT_TRUE(selection.error) << bad;
-    EXPECT_EQ(selection.error->status, 400) << bad;
-  }
-}
-
-TEST(HttpRouter, StatusFormatFromParameterOrAccept) {
-  EXPECT_FALSE(status_format(request("GET", "/status")).text);
-  EXPECT_TRUE(status_format(request("GET", "/status?format=text")).text);
-  EXPECT_FALSE(status_format(request("GET", "/status?format=json")).text);
-  HttpRequest plain = request("GET", "/status");
-  plain.accept = "text/plain";
-  EXPECT_TRUE(status_format(plain).text);
-  plain.accept = "application/json, text/plain;q=0.5";
-  EXPECT_FALSE(status_format(plain).text);
-  for (const char* bad :
-       {"/status?format=xml", "/status?verbose=1", "/status?format=text&format=text"}) {
-    const StatusFormat format = status_format(request("GET", bad));
-    ASSERT_TRUE(format.error) << bad;
-    EXPECT_EQ(format.error->status, 400) << bad;
-  }
-}
-
-TEST(StatusJson, StringsAreAlwaysValidJsonAndNumbersNeverNan) {
-  using io::json_string;
-  EXPECT_EQ(json_string("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\n\\u0001\"");
-  EXPECT_EQ(json_string("\xc3\xa9"), "\"\xc3\xa9\"");
-  EXPECT_EQ(json_string("x\xff\xc3"), "\"x\\ufffd\\ufffd\"");           // invalid, truncated
-  EXPECT_EQ(json_string("\xed\xa0\x80"), "\"\\ufffd\\ufffd\\ufffd\"");  // a surrogate
-  EXPECT_EQ(views::json_number(NAN), "null");
-  EXPECT_EQ(views::json_number(INFINITY), "null");
-  EXPECT_EQ(views::json_number(1.5), "1.5");
-}
-
-// The human form from a document as the daemon writes it, with values not known yet.
-TEST(StatusJson, HumanFormSaysWhatIsNotKnownInsteadOfNan) {
-  const std::string json =
-      R"({"version":"0.1.0","uptime_s":12.4,"config":"demo.yaml","reload":{"ok":true},)"
-      R"("groups":[{"name":"main","cycles":6000,"overruns":0,"missed_cycles":0,"ring_drops":0,)"
-      R"("ring_high_water":3,"ring_capacity":8192,"realtime":false,)"
-      R"("wakeup_latency_us":{"mean":null,"max":null},"ended":false}],)"
-      R"("drivers":[{"name":"rig","status":"ok","detail":"ok","last_error":null,"errors":0}],)"
-      R"("actuators":[{"name":"cyl","detector":"flow_balance","state":"learning",)"
-      R"("learning_seconds_left":22.3,"t":12.0,"index_pa":{"p1":25000,"p2":null},"score":null,)"
-      R"("threshold":{"raise":1,"clear":0.5},"baseline_pa":null,)"
-      R"("leak_lpm_per_mpa":{"estimate":null,"ci95":null},"oil_temperature_c":null,)"
-      R"("alarms":[{"name":"internal_leakage","state":"normal"}],"suspended":false,)"
-      R"("sensors":[{"channel":"p2","status":"ok","fault":null,"spikes_rejected":0}]}]})";
-  const std::string text = views::status_text_from_json(json);
-  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
-  EXPECT_NE(text.find("learning, 23 s left"), std::string::npos) << text;
-  EXPECT_NE(text.find("p2 n/a"), std::string::npos) << text;
-  EXPECT_NE(text.find("leak estimate n/a"), std::string::npos) << text;
-  EXPECT_NE(text.find("channel p2: ok"), std::string::npos) << text;
-  EXPECT_THROW(views::status_text_from_json("not json {"), std::runtime_error);
-  EXPECT_THROW(views::status_text_from_json("{\"x\":1}"), std::runtime_error);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@ the order that do not exist are skipped.
     check_layering.py --self-test check scratch trees with known violations (and good ones)
 """
 
+import io
 import pathlib
 import re
 import sys
@@ -179,9 +180,9 @@ def violations(root):
     return order_violations(root) + loop_violations(root)
 
 
-def report(found):
+def report(found, out=None):
     for file, line, message in found:
-        print(f"{file}:{line}: {message}")
+        print(f"{file}:{line}: {message}", file=out or sys.stdout)
     return 1 if found else 0
 
 
@@ -209,7 +210,7 @@ def self_test():
             for word in words:
                 if not any(word in message for _, _, message in found):
                     failures.append(f"{name}: no message says '{word}': {found}")
-            if expected and report(found) != 1:
+            if expected and report(found, io.StringIO()) != 1:
                 failures.append(f"{name}: a bad tree does not give exit status 1")
 
     good = {

@@ -46,7 +46,7 @@ TEST(DriftReplay, WarmUpAndSupplyChangeAreNotALeakAndTheLeakAfterIsSizedAt40C) {
     SCOPED_TRACE(with_temp ? "temp column" : "no temp column");
     const capture::Capture capture = drifting_capture(with_temp);
     const DaemonConfig config = default_replay_config(capture);
-    EXPECT_EQ(config.actuators.front().temp.present(), with_temp);
+    EXPECT_EQ(config.actuators.front().channels[capture::Role::temp].present(), with_temp);
     const ReplayResult result = replay_capture(capture, config);
     const auto alarms = leak_alarms(result);
     ASSERT_FALSE(alarms.empty());

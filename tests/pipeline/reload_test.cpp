@@ -14,7 +14,6 @@
 #include "pipeline/worker.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
-#include "views/metrics_text.hpp"
 
 namespace leakmon::pipeline {
 namespace {

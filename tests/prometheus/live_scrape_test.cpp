@@ -82,7 +82,7 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
 
   const std::string alarm =
       "leakmon_alarm_active{actuator=\"cylinder\",alarm=\"internal_leakage\","
-      "state=\"active_unacknowledged\"}";
+      "alarm_state=\"active_unacknowledged\",state=\"active_unacknowledged\"}";
   std::string scrape;
   const bool alarmed = test::eventually(
       [&] {

@@ -89,7 +89,9 @@ def wait_for(what, condition, timeout_s):
 
 
 def alarm_metric(metrics, state):
-    prefix = f'leakmon_alarm_active{{actuator="cylinder",alarm="internal_leakage",state="{state}"}}'
+    # alarm_state is the alarm's ISA-18.2 state; `state` repeats it for one release.
+    prefix = (f'leakmon_alarm_active{{actuator="cylinder",alarm="internal_leakage",'
+              f'alarm_state="{state}",state="{state}"}}')
     return any(line.startswith(prefix + " 1") for line in metrics.splitlines())
 
 

@@ -243,9 +243,10 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.learning_seconds_left = 37.5;
   fresh.mode_visibility = 1.6;  // learned on a rig whose hydraulic mode did not show
   fresh.detection_blind = true;
-  const std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator(), fresh};
+  std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator(), fresh};
+  actuators[0].learned_state_saved_unix = 1000.0;
   PrometheusText out;
-  actuator_metrics(out, actuators, {{"lift", 1000.0}, {"gone", 10.0}}, 1042.5);
+  actuator_metrics(out, actuators, 1042.5);
   const std::string text = out.text();
 
   EXPECT_NEAR(std::stod(value_of(text, "leakmon_leak_lpm_per_mpa{actuator=\"lift\"}")), 0.15,
@@ -285,22 +286,23 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   EXPECT_EQ(value_of(text, "leakmon_detection_blind{actuator=\"lift\"}"), "0");
 
   EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "42.5");
-  // No saved state: no age sample (not a zero that would read as "just saved"); an actuator
-  // that is no longer configured is not reported either.
+  // No saved state: no age sample (not a zero that would read as "just saved").
   EXPECT_EQ(lines_starting(text, "leakmon_learned_state_age_seconds{"), 1u);
 
+  // The alarm's ISA-18.2 state, under its one name and, for one release, under `state`.
   EXPECT_EQ(value_of(text,
                      "leakmon_alarm_active{actuator=\"lift\",alarm=\"internal_leakage\","
-                     "state=\"active_unacknowledged\"}"),
+                     "alarm_state=\"active_unacknowledged\",state=\"active_unacknowledged\"}"),
             "1");
   EXPECT_EQ(value_of(text, "leakmon_index_pascal{actuator=\"lift\",channel=\"p2\"}"), "1250");
   EXPECT_EQ(lines_starting(text, "leakmon_index_pascal{actuator=\"clamp\""), 1u);
 }
 
 TEST(MetricsText, ActuatorFamiliesHaveOneHeaderEachAndTheTextFormatShape) {
-  const std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator()};
+  std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator()};
+  actuators[0].learned_state_saved_unix = 5.0;
   PrometheusText out;
-  actuator_metrics(out, actuators, {{"lift", 5.0}}, 4.0);  // a clock that stepped back
+  actuator_metrics(out, actuators, 4.0);  // a clock that stepped back
   const std::string text = out.text();
   EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "0");
   for (const char* family : {"leakmon_leak_lpm_per_mpa", "leakmon_leak_lpm_per_mpa_ci95",

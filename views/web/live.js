@@ -75,8 +75,10 @@ function windowRange(times) {
   return { min: times[0], max: last };
 }
 
-const TREND_COLUMNS = ["time", "index_p1", "index_p2", "score", "raise_threshold",
-  "leak_lpm_per_mpa", "leak_lpm_per_mpa_ci95", "p1", "p2", "oil_temperature", "alarm"];
+// The vocabulary of /status and /api/trend (docs/daemon.md "Vocabulary").
+const TREND_COLUMNS = ["time", "index_p1_pa", "index_p2_pa", "score", "raise_threshold",
+  "leak_lpm_per_mpa", "leak_lpm_per_mpa_ci95", "p1_pa", "p2_pa", "oil_temperature_c",
+  "alarm_state_code"];
 
 function tile(label) {
   const t = el("div", "tile");
@@ -136,14 +138,14 @@ function createActuator(a) {
     card, alarm, learning, suspended, blind, ack, result, tiles: t, data, charts: [],
   };
   entry.build = [
-    () => [data.time, data.index_p1.map(kpa), data.index_p2.map(kpa)],
+    () => [data.time, data.index_p1_pa.map(kpa), data.index_p2_pa.map(kpa)],
     () => [data.time, data.score, data.raise_threshold],
     () => [data.time, data.leak_lpm_per_mpa,
       data.leak_lpm_per_mpa.map((v, i) => (v === null || data.leak_lpm_per_mpa_ci95[i] === null
         ? null : v + data.leak_lpm_per_mpa_ci95[i])),
       data.leak_lpm_per_mpa.map((v, i) => (v === null || data.leak_lpm_per_mpa_ci95[i] === null
         ? null : v - data.leak_lpm_per_mpa_ci95[i]))],
-    () => [data.time, data.p1.map(mpa), data.p2.map(mpa), data.oil_temperature],
+    () => [data.time, data.p1_pa.map(mpa), data.p2_pa.map(mpa), data.oil_temperature_c],
   ];
   const empty = (n) => [[]].concat(Array.from({ length: n }, () => []));
   entry.charts.push(makeChart(charts, "wavelet index [kPa]", [
@@ -169,29 +171,29 @@ function createActuator(a) {
 function updateActuator(a) {
   const entry = view.actuators.get(a.name) || createActuator(a);
   const { card, tiles } = entry;
-  entry.alarm.textContent = a.alarm + ": " + a.state;
-  entry.alarm.className = "badge alarm-state " + stateClass(a.state);
-  card.dataset.alarmState = a.state;
-  card.classList.toggle("alarmed", a.state !== "normal");
+  entry.alarm.textContent = a.alarm + ": " + a.alarm_state;
+  entry.alarm.className = "badge alarm-state " + stateClass(a.alarm_state);
+  card.dataset.alarmState = a.alarm_state;
+  card.classList.toggle("alarmed", a.alarm_state !== "normal");
   entry.learning.hidden = !a.learning;
   entry.suspended.hidden = !a.suspended;
   entry.blind.hidden = !a.detection_blind;
-  entry.ack.disabled = a.state === "normal";
+  entry.ack.disabled = a.alarm_state === "normal";
   tiles.index.value.textContent =
-    fmt(scaled(a.index_p1, 1e3), 2) + " / " + fmt(scaled(a.index_p2, 1e3), 2);
+    fmt(scaled(a.index_p1_pa, 1e3), 2) + " / " + fmt(scaled(a.index_p2_pa, 1e3), 2);
   tiles.score.value.textContent = fmt(a.score, 3) + " / " + fmt(a.raise_threshold, 3);
   tiles.leak.value.textContent = Number.isFinite(a.leak_lpm_per_mpa)
     ? fmt(a.leak_lpm_per_mpa, 3) + " ± " + fmt(a.leak_lpm_per_mpa_ci95, 3) : "–";
   tiles.pressure.value.textContent =
-    fmt(scaled(a.p1, 1e6), 2) + " / " + fmt(scaled(a.p2, 1e6), 2);
+    fmt(scaled(a.p1_pa, 1e6), 2) + " / " + fmt(scaled(a.p2_pa, 1e6), 2);
   tiles.temperature.value.textContent =
-    a.oil_temperature === null ? "not acquired" : fmt(a.oil_temperature, 1);
+    a.oil_temperature_c === null ? "not acquired" : fmt(a.oil_temperature_c, 1);
   tiles.decisions.value.textContent = String(a.decisions);
   const sensors = tiles.sensors.value;
   sensors.replaceChildren();
-  for (const c of a.channels) {
+  for (const c of a.sensors) {
     const b = el("span", "badge " + statusClass(c.status),
-      c.channel + ": " + c.status + (c.fault !== "none" ? " (" + c.fault + ")" : ""));
+      c.channel + ": " + c.status + (c.fault !== null ? " (" + c.fault + ")" : ""));
     b.dataset.channel = c.channel;
     sensors.appendChild(b);
     sensors.appendChild(document.createTextNode(" "));
@@ -214,7 +216,8 @@ function updateLoops(trend) {
     const row = el("tr");
     row.dataset.group = g.name;
     for (const text of [g.name, g.realtime ? "SCHED_FIFO" : "normal", String(g.cycles),
-      fmt(g.latency_mean_us, 1) + " / " + fmt(g.latency_p99_us, 0) + " / " + fmt(g.latency_max_us, 0),
+      fmt(g.wakeup_latency_mean_us, 1) + " / " + fmt(g.wakeup_latency_p99_us, 0) + " / " +
+        fmt(g.wakeup_latency_max_us, 0),
       String(g.overruns), String(g.missed_cycles), String(g.ring_drops),
       g.ring_high_water + " / " + g.ring_capacity]) {
       row.appendChild(el("td", null, text));
@@ -226,7 +229,7 @@ function updateLoops(trend) {
   const g = trend.groups[0];
   if (!g || !g.trend) return;
   if (!view.loop) {
-    const data = { time: [], latency_mean_us: [], overruns: [] };
+    const data = { time: [], wakeup_latency_mean_us: [], overruns: [] };
     const chart = makeChart($("loop-chart"), "group " + g.name +
       ": mean wake-up latency [µs] per interval, overruns", [
       { label: "latency", stroke: "#1f77b4" },
@@ -236,9 +239,9 @@ function updateLoops(trend) {
     view.loop = { data, chart };
     requestAnimationFrame(resize);
   }
-  appendColumns(view.loop.data, g.trend, ["time", "latency_mean_us", "overruns"]);
+  appendColumns(view.loop.data, g.trend, ["time", "wakeup_latency_mean_us", "overruns"]);
   const d = view.loop.data;
-  view.loop.chart.chart.setData([d.time, d.latency_mean_us, d.overruns], false);
+  view.loop.chart.chart.setData([d.time, d.wakeup_latency_mean_us, d.overruns], false);
   const range = windowRange(d.time);
   if (range) view.loop.chart.chart.setScale("x", range);
 }
