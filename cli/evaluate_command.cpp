@@ -4,8 +4,9 @@
 // (sim/) and replays it in process through exactly the daemon's pipeline
 // (pipeline::replay_capture). Every detector under test is one actuator of the replayed
 // configuration, at several alarm thresholds, so one replay yields the whole ROC sweep. Writes
-// runs.json (every run and alarm), summary.json, summary.tsv and summary.md into --out, and the
-// plots when --plots is given (docs/tools/detection_plots.py). The harness is study/ (case
+// runs.json (every run and alarm), summary.json, summary.tsv, summary.md, conditions.md and
+// conditions.tsv into --out (programs.tsv and wear.tsv under those conditions), and the plots
+// when --plots is given (docs/tools/detection_plots.py). The harness is study/ (case
 // generation, runner, aggregation, writers); this front end parses the options and calls it.
 #include <fmt/format.h>
 
@@ -25,6 +26,7 @@
 #include "study/evaluation_options.hpp"
 #include "study/evaluation_runner.hpp"
 #include "study/evaluation_writers.hpp"
+#include "study/rig_cases.hpp"
 
 namespace leakmon::cli {
 
@@ -75,10 +77,13 @@ int run_evaluate(int argc, char** argv) {
               "MODEL.md effects switched on in every run (default parameters), comma-separated", "")
       .option("conditions", "LIST",
               "operating conditions the runs cycle through, comma-separated: stationary, warmup, "
-              "cooler, supply, sensor-faults, restart (MODEL.md drifting conditions and sensor "
-              "faults; restart: stopped after learning, restarted from the saved state after a "
-              "downtime in which the oil changed by 1-5 K and a leak run's leak opened); adds "
-              "conditions.md and conditions.tsv",
+              "cooler, supply, sensor-faults, restart, programs, wear (MODEL.md drifting "
+              "conditions and sensor faults; restart: stopped after learning, restarted from the "
+              "saved state after a downtime in which the oil changed by 1-5 K and a leak run's "
+              "leak opened; programs: random test programs of 3-8 phases, healthy runs as long as "
+              "their program, leak runs opening in each phase kind in turn; wear: leak runs whose "
+              "C_L grows from 0 to 1e-12..5e-12 over 10 min to 4 h, the oil cycling with the "
+              "cooler); adds conditions.md and conditions.tsv, and programs.tsv, wear.tsv",
               "stationary")
       .option("sensor-fault-runs", "N",
               "extra runs with one sensor fault each (the six kinds in turn, each kind's runs "
@@ -86,6 +91,16 @@ int run_evaluate(int argc, char** argv) {
               "conditions.md",
               "0")
       .option("after-restart", "S", "how long a healthy restart is watched", "300")
+      .option("time-scale", "X",
+              "programs and wear: phase lengths and wear times are MODEL.md's typical values "
+              "times X (less than 1 for a quick check)",
+              "1")
+      .option("rigs", "paper|other",
+              "paper: the paper's rig across MODEL.md's calibration spread; other: each run on a "
+              "rig drawn from MODEL.md \"Other rigs\", leak sizes relative to its valve (C_L = "
+              "size x Kv / 3.39e-7), the default detector on three sets of channels told the rig "
+              "and not told; writes rigs.md, rigs.tsv and rigs_runs.tsv (stationary runs only)",
+              "paper")
       .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
               "")
       .flag("plots", "also draw the plots (matplotlib via /usr/bin/python3)")
@@ -111,24 +126,37 @@ int run_evaluate(int argc, char** argv) {
   }
   settings.sensor_fault_runs = static_cast<int>(args.get_int("sensor-fault-runs"));
   settings.after_restart_seconds = args.get_double("after-restart");
+  settings.time_scale = args.get_double("time-scale");
   settings.conditions = split(args.get("conditions"));
   for (const auto& condition : settings.conditions) {
     if (!study::is_condition(condition)) {
       throw UsageError(fmt::format(
           "option '--conditions': unknown condition '{}' (known: stationary, warmup, cooler, "
-          "supply, sensor-faults, restart)",
+          "supply, sensor-faults, restart, programs, wear)",
           condition));
     }
   }
   if (settings.conditions.empty()) settings.conditions = {"stationary"};
   if (settings.healthy_runs < 0 || settings.runs_per_leak < 0 || settings.sensor_fault_runs < 0 ||
-      settings.jobs < 1 || !(settings.after_restart_seconds > 0.0)) {
-    throw UsageError("run counts must be >= 0, --jobs >= 1 and --after-restart > 0");
+      settings.jobs < 1 || !(settings.after_restart_seconds > 0.0) ||
+      !(settings.time_scale > 0.0 && settings.time_scale <= 100.0)) {
+    throw UsageError(
+        "run counts must be >= 0, --jobs >= 1, --after-restart > 0 and 0 < --time-scale <= 100");
   }
   if (settings.learn_seconds < 1 || settings.healthy_seconds < settings.learn_seconds + 10 ||
       settings.after_onset_seconds < settings.detect_within) {
     throw UsageError(
         "need --learn-seconds >= 1, --healthy-seconds >= learn + 10, --after-onset >= 60");
+  }
+  settings.rigs = args.get("rigs");
+  if (settings.rigs != "paper" && settings.rigs != "other") {
+    throw UsageError(fmt::format("option '--rigs': '{}' is not paper or other", settings.rigs));
+  }
+  if (settings.rigs == "other" && (settings.conditions != std::vector<std::string>{"stationary"} ||
+                                   settings.sensor_fault_runs > 0)) {
+    throw UsageError(
+        "--rigs other runs stationary conditions only (drop --conditions and "
+        "--sensor-fault-runs)");
   }
   for (double id : parse_list("keep-captures", args.get("keep-captures"))) {
     settings.keep_captures.push_back(static_cast<int>(id));
@@ -138,12 +166,26 @@ int run_evaluate(int argc, char** argv) {
   std::filesystem::create_directories(out);
 
   const std::vector<study::RunSpec> runs = study::draw_runs(settings);
+  const auto show_progress = [](std::size_t done, std::size_t total) {
+    fmt::print(stderr, "\r[{}/{}] runs evaluated", done, total);
+    std::fflush(stderr);
+  };
+  if (settings.rigs == "other") {
+    std::vector<study::RigRunResult> rig_results;
+    try {
+      rig_results = study::run_rig_evaluation(runs, settings, show_progress);
+    } catch (...) {
+      fmt::print(stderr, "\n");
+      throw;
+    }
+    fmt::print(stderr, "\n");
+    study::write_rig_summaries(out, settings, rig_results);
+    fmt::print("wrote {}/rigs.md, rigs.tsv, rigs_runs.tsv\n", out.string());
+    return 0;
+  }
   std::vector<study::RunResult> results;
   try {
-    results = study::run_evaluation(runs, settings, [](std::size_t done, std::size_t total) {
-      fmt::print(stderr, "\r[{}/{}] runs evaluated", done, total);
-      std::fflush(stderr);
-    });
+    results = study::run_evaluation(runs, settings, show_progress);
   } catch (...) {
     fmt::print(stderr, "\n");
     throw;
@@ -155,8 +197,9 @@ int run_evaluate(int argc, char** argv) {
   study::write_condition_summaries(out, settings, results);
   fmt::print(
       "wrote {}/runs.json, summary.json, summary.tsv, summary.md, size_coverage.tsv, "
-      "conditions.md, conditions.tsv\n",
-      out.string());
+      "conditions.md, conditions.tsv{}{}\n",
+      out.string(), std::filesystem::exists(out / "programs.tsv") ? ", programs.tsv" : "",
+      std::filesystem::exists(out / "wear.tsv") ? ", wear.tsv" : "");
 
   if (args.flag_set("plots")) {
     const std::string command =

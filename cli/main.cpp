@@ -20,6 +20,7 @@ constexpr Subcommand kSubcommands[] = {
     {"run", "run the leak monitoring daemon (--config CONFIG.yaml)", leakmon::cli::run_run},
     {"replay", "feed a capture through the daemon's pipeline, write its events", leakmon::cli::run_replay},
     {"check-config", "validate a daemon configuration without running it", leakmon::cli::run_check_config},
+    {"probe", "read every configured channel once, in SI units with its status", leakmon::cli::run_probe},
     {"status", "summary from the running daemon", leakmon::cli::run_status},
     {"ack", "acknowledge alarms in the running daemon", leakmon::cli::run_ack},
     {"state", "show or reset what the daemon keeps across restarts", leakmon::cli::run_state},

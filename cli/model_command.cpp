@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "capture/capture.hpp"
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "model/diagnosis.hpp"
@@ -18,6 +19,8 @@
 #include "model/measured_record.hpp"
 #include "model/report.hpp"
 #include "model/result_json.hpp"
+#include "model/rig_source.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::cli {
 namespace {
@@ -29,18 +32,44 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 int run_check(int argc, char** argv) {
-  ArgParser args("model check",
-                 "Calibrates beta, Kv, m, b on the fitting part of a capture, extends the model\n"
-                 "with each effect of MODEL.md's library, scores each on held-out data and names\n"
-                 "the best when its gain is significant (else `none`). Writes FORMATS.md's JSON.");
+  ArgParser args(
+      "model check",
+      "Checks the rig's stated values that the capture can check (supply, load\n"
+      "stiffness), calibrates beta, Kv, m, b around the stated ones on the fitting part\n"
+      "of a capture, extends the model with each effect of MODEL.md's library, scores\n"
+      "each on held-out data and names the best when its gain is significant (else\n"
+      "`none`). Writes FORMATS.md's JSON. Without --rig or --config the rig is the\n"
+      "paper's (MODEL.md's nominal values).");
   args.option("data", "CAPTURE.csv", "capture with at least t,u,x,p1,p2 at 500 Hz", std::nullopt,
               true)
       .option("json", "RESULT.json", "where to write the result", std::nullopt, true)
+      .option("rig", "RIG.yaml", "the rig's description: a file whose top-level key is rig:", "")
+      .option("config", "CONFIG.yaml", "the daemon's configuration: take --actuator's rig:", "")
+      .option("actuator", "NAME", "the actuator of --config whose rig: to take", "")
       .option("report", "DIR", "also write a Markdown report with plots into DIR", "");
   if (!args.parse(argc, argv, 2)) return 0;
+  const std::string rig_file = args.get("rig");
+  const std::string config_file = args.get("config");
+  const std::string actuator = args.get("actuator");
+  if (!rig_file.empty() && !config_file.empty()) {
+    throw UsageError("give the rig once: --rig RIG.yaml or --config CONFIG.yaml --actuator NAME");
+  }
+  if (config_file.empty() != actuator.empty()) {
+    throw UsageError(
+        "--config and --actuator go together: the actuator of the configuration "
+        "whose rig: the capture was recorded on");
+  }
+  sim::RigDescription rig = sim::RigDescription::paper();
+  if (!rig_file.empty()) rig = sim::load_rig_file(rig_file);
+  if (!config_file.empty()) rig = model::load_actuator_rig(config_file, actuator);
   const model::MeasuredRecord record = model::read_measured_record(args.get("data"));
-  const model::Diagnosis d = model::diagnose(record);
+  fmt::print("rig: {}\n", sim::describe(rig));
+  const model::Diagnosis d = model::diagnose(record, rig);
   write_text(args.get("json"), model::diagnosis_json(d));
+  for (const auto& finding : d.rig_check.findings) {
+    fmt::print("stated {} {:.4g} contradicted by the data: {:.4g}\n", finding.parameter,
+               finding.stated, finding.fitted);
+  }
   fmt::print("cause: {} (held-out NRMSE {:.4f} -> {:.4f})\n", d.cause, d.nrmse_before,
              d.nrmse_after);
   if (const auto dir = args.get("report"); !dir.empty()) {
@@ -63,15 +92,28 @@ int run_evaluate_cases(int argc, char** argv) {
       .option("duration", "SECONDS", "length of each simulated capture", "60")
       .option("classes", "LIST",
               "comma-separated case classes, taken in turn: library (the eleven effects and "
-              "none), pair, warmup_temp, warmup_no_temp, edge, beyond, clean",
+              "none), pair, warmup_temp, warmup_no_temp, edge, beyond, clean, misstated (a "
+              "stated value wrong), onset (an effect appearing inside the capture)",
               "library")
-      .option("out", "DIR", "output directory", std::nullopt, true);
+      .option("rigs", "WHICH",
+              "paper (MODEL.md's rig) or other (rigs drawn from MODEL.md's 'Other rigs' "
+              "ranges, each told its description; classes misstated and onset as well)",
+              "paper")
+      .option("out", "DIR", "output directory", std::nullopt, true)
+      .flag("keep-captures",
+            "also write each case's capture (OUT/case-SEED.csv) and the rig it was told "
+            "(OUT/case-SEED-rig.yaml), for `leakmon model check --rig`");
   if (!args.parse(argc, argv, 2)) return 0;
   const long long cases = args.get_int("cases");
   if (cases < 1) throw UsageError("option '--cases': must be at least 1");
   const auto first = static_cast<std::uint64_t>(args.get_int("seed"));
   model::CaseSettings case_settings;
   case_settings.duration_s = args.get_double("duration");
+  const std::string rigs = args.get("rigs");
+  if (rigs != "paper" && rigs != "other") {
+    throw UsageError(fmt::format("option '--rigs': '{}' is neither paper nor other", rigs));
+  }
+  case_settings.other_rig = rigs == "other";
   std::vector<std::string> kinds;
   const std::string list = args.get("classes");
   for (std::size_t begin = 0; begin <= list.size();) {
@@ -84,12 +126,19 @@ int run_evaluate_cases(int argc, char** argv) {
     kinds.push_back(kind);
     begin = end + 1;
   }
+  const std::string dir = args.get("out");
+  std::filesystem::create_directories(dir);
   model::EvaluationSummary summary;
   for (long long i = 0; i < cases; ++i) {
     const auto index = static_cast<std::size_t>(i);
     const auto& kind = kinds[index % kinds.size()];
     const auto [effect, settings] = model::case_of_kind(kind, index / kinds.size(), case_settings);
     const auto seed = first + static_cast<std::uint64_t>(i);
+    if (args.flag_set("keep-captures")) {
+      const model::SyntheticCase c = model::draw_case(seed, effect, settings);
+      capture::write_capture(fmt::format("{}/case-{}.csv", dir, seed), model::simulate_case(c));
+      write_text(fmt::format("{}/case-{}-rig.yaml", dir, seed), model::rig_file_text(c.told));
+    }
     summary.cases.push_back(model::evaluate_case(seed, effect, settings));
     summary.cases.back().kind = kind;
     const auto& c = summary.cases.back();
@@ -100,10 +149,18 @@ int run_evaluate_cases(int argc, char** argv) {
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z);
     fmt::print("  {} causes [{}] floor {:.4f} true {:.4f} achieved {:.2f} drifts {} steps {}\n",
                c.kind, c.causes, c.nrmse_floor, c.nrmse_true, c.achieved, c.drifts, c.steps);
+    if (case_settings.other_rig || !c.misstated.empty() || c.onset_true > 0.0) {
+      std::string findings;
+      for (const auto& f : c.rig_findings) {
+        findings += fmt::format(" {} {:.4g}->{:.4g}", f.parameter, f.stated, f.fitted);
+      }
+      fmt::print(
+          "  rig {}; misstated {} (true {:.4g} told {:.4g}); found{}; onset {:.2f} -> {:.2f}\n",
+          c.rig, c.misstated.empty() ? "-" : c.misstated, c.misstated_true, c.misstated_stated,
+          findings.empty() ? " nothing" : findings, c.onset_true, c.onset_estimate);
+    }
     std::fflush(stdout);
   }
-  const std::string dir = args.get("out");
-  std::filesystem::create_directories(dir);
   write_text(dir + "/cases.csv", summary.csv());
   const std::string markdown =
       summary.targets_markdown() + "\n" + summary.kind_markdown() + "\n" + summary.markdown();
@@ -116,9 +173,11 @@ int run_evaluate_cases(int argc, char** argv) {
 
 int run_model(int argc, char** argv) {
   const std::string_view usage =
-      "usage: leakmon model check --data CAPTURE.csv --json RESULT.json [--report DIR]\n"
+      "usage: leakmon model check --data CAPTURE.csv --json RESULT.json\n"
+      "                           [--rig RIG.yaml | --config CONFIG.yaml --actuator NAME]\n"
+      "                           [--report DIR]\n"
       "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n"
-      "                              [--classes LIST]\n";
+      "                              [--classes LIST] [--rigs paper|other]\n";
   if (argc < 2) throw UsageError(std::string(usage));
   const std::string_view action = argv[1];
   if (action == "-h" || action == "--help") {

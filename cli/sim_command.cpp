@@ -13,6 +13,7 @@
 #include "config/yaml_reader.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "sim/summary.hpp"
 
 namespace leakmon::cli {
 
@@ -57,6 +58,7 @@ int run_sim(int argc, char** argv) {
   } else {
     scenario = sim::load_scenario(*scenario_path);  // config::ConfigError: file:line:column
     if (args.has("seed")) scenario.seed = seed;
+    for (const auto& warning : scenario.warnings) fmt::print(stderr, "warning: {}\n", warning);
   }
   if (args.has("duration")) {
     const double duration = args.get_double("duration");
@@ -81,6 +83,12 @@ int run_sim(int argc, char** argv) {
       }
       begin = end + 1;
     }
+  }
+  // What the capture will hold, before the run (minutes for a long one): a shortened run that
+  // ends before its leak is said, not silent.
+  fmt::print(stderr, "leakmon sim: {} -> {}\n", sim::summary_line(scenario), args.get("out"));
+  for (const auto& warning : sim::starts_after_end(scenario)) {
+    fmt::print(stderr, "leakmon sim: warning: {}\n", warning);
   }
   sim::simulate_to_file(scenario, args.get("out"));
   return 0;

@@ -13,22 +13,12 @@
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
+#include "detect/legacy_state.hpp"
 #include "pipeline/replay.hpp"
 #include "pipeline/state_store.hpp"
 
 namespace leakmon::cli {
 namespace {
-
-// Learned when any (member) detector says so: a fitted model or a baseline.
-bool learned(const detect::DetectorState& state) {
-  for (const auto& [key, values] : state.entries()) {
-    const bool model = key == "learned_model" || key.ends_with(".learned_model");
-    const bool baseline = key == "baseline" || key.ends_with(".baseline");
-    if (values.size() == 1 && ((model && values[0] != 0.0) || (baseline && !std::isnan(values[0]))))
-      return true;
-  }
-  return false;
-}
 
 std::string utc(double unix_seconds) {
   const auto t = std::chrono::system_clock::time_point(
@@ -73,8 +63,9 @@ int show(const Target& target) {
   for (const auto& state : listing.states) {
     fmt::print("actuator {}: saved {}, detector {} ({}), alarm {}{}\n", state.actuator,
                utc(state.saved_unix), state.detector.kind(),
-               learned(state.detector) ? "learned" : "still learning",
-               pipeline::to_string(state.alarm), state.alarm_condition ? " (condition active)" : "");
+               detect::has_learned(state.detector) ? "learned" : "still learning",
+               pipeline::to_string(state.alarm),
+               state.alarm_condition ? " (condition active)" : "");
     for (const auto& [name, value] : state.fingerprint.parts) {
       fmt::print("  {}: {}\n", name, value);
     }
@@ -147,7 +138,7 @@ int learn(const Target& target, const std::string& capture_path) {
     state.alarm = pipeline::AlarmState::normal;
     state.alarm_condition = false;
     store.save(state);
-    const bool done = learned(state.detector);
+    const bool done = detect::has_learned(state.detector);
     fmt::print("actuator {}: {} -> {}\n", state.actuator,
                done ? "learned" : "capture too short, still learning",
                store.file_of(state.actuator).string());

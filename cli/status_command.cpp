@@ -12,7 +12,9 @@
 namespace leakmon::cli {
 namespace {
 
-constexpr const char* kDefaultConfig = "/etc/leakmon/leakmon.yaml";
+// Where the installed unit reads its configuration (LEAKMON_CONFIG_DIR at build time), so that
+// `status` and `ack` find the service's port and token without --config.
+constexpr const char* kDefaultConfig = LEAKMON_DEFAULT_CONFIG;
 
 void endpoint_options(ArgParser& args) {
   args.option("config", "CONFIG.yaml",

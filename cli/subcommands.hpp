@@ -12,6 +12,7 @@ int run_realdata(int argc, char** argv);
 int run_run(int argc, char** argv);
 int run_replay(int argc, char** argv);
 int run_check_config(int argc, char** argv);
+int run_probe(int argc, char** argv);
 int run_status(int argc, char** argv);
 int run_ack(int argc, char** argv);
 int run_state(int argc, char** argv);

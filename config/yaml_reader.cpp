@@ -200,6 +200,107 @@ static void reject_further_documents(const std::string& text, const std::string&
   }
 }
 
+namespace {
+
+// The lines of `text`, without their line ends.
+std::vector<std::string_view> split_lines(std::string_view text) {
+  std::vector<std::string_view> lines;
+  for (std::size_t from = 0; from <= text.size();) {
+    const std::size_t end = std::min(text.find('\n', from), text.size());
+    std::string_view line = text.substr(from, end - from);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines.push_back(line);
+    from = end + 1;
+  }
+  return lines;
+}
+
+bool is_content(std::string_view line) {
+  const std::size_t first = line.find_first_not_of(' ');
+  return first != std::string_view::npos && line[first] != '#';
+}
+
+// Columns (1-based) where block content starts on `line`: after the indentation, and after each
+// list dash ("  - name: x" starts content at columns 3 and 5).
+std::vector<std::size_t> content_columns(std::string_view line) {
+  std::vector<std::size_t> columns;
+  std::size_t at = line.find_first_not_of(' ');
+  while (at != std::string_view::npos) {
+    columns.push_back(at + 1);
+    if (line[at] != '-' || at + 1 >= line.size() || line[at + 1] != ' ') break;
+    at = line.find_first_not_of(' ', at + 1);
+  }
+  return columns;
+}
+
+// What is probably wrong where yaml-cpp stopped: the parser's own words name the grammar rule,
+// an operator needs the mistake (indentation, tabs, an unclosed bracket, an unquoted colon).
+std::string syntax_hint(const std::string& text, const YAML::Exception& e) {
+  const auto lines = split_lines(text);
+  const bool located = !e.mark.is_null() && e.mark.line >= 0;
+  const std::size_t line_index = located ? static_cast<std::size_t>(e.mark.line) : lines.size();
+  for (std::size_t i = 0; i <= line_index && i < lines.size(); ++i) {
+    const std::string_view line = lines[i];
+    const std::size_t first = line.find_first_not_of(" \t");
+    const std::string_view indent = line.substr(0, std::min(first, line.size()));
+    if (indent.find('\t') != std::string_view::npos && first != std::string_view::npos) {
+      return fmt::format("line {} is indented with a tab: YAML indents with spaces only", i + 1);
+    }
+  }
+  if (!located || line_index >= lines.size()) return "";
+  const std::string_view here = lines[line_index];
+  // The columns the content above begins at, nearest line first: where this line could belong.
+  std::vector<std::size_t> above;
+  std::size_t previous_line = 0;
+  for (std::size_t i = line_index; i-- > 0;) {
+    if (!is_content(lines[i])) continue;
+    if (previous_line == 0) previous_line = i + 1;
+    for (std::size_t column : content_columns(lines[i])) {
+      if (std::find(above.begin(), above.end(), column) == above.end()) above.push_back(column);
+    }
+  }
+  std::sort(above.begin(), above.end());
+  const std::size_t column = here.find_first_not_of(' ') + 1;
+  const std::string& msg = e.msg;
+  if (msg.find("flow") != std::string::npos) {
+    const bool map = msg.find("map") != std::string::npos;
+    return fmt::format(
+        "an inline {} opened with '{}' is not closed with '{}' (or a ',' is missing "
+        "between its entries)",
+        map ? "mapping" : "list", map ? '{' : '[', map ? '}' : ']');
+  }
+  if (msg.find("end of map not found") != std::string::npos ||
+      msg.find("end of sequence not found") != std::string::npos ||
+      msg.find("illegal block entry") != std::string::npos ||
+      msg.find("block sequence entries are not allowed") != std::string::npos) {
+    if (std::find(above.begin(), above.end(), column) == above.end() && !above.empty()) {
+      return fmt::format(
+          "probably wrong indentation: line {} starts at column {}, but the blocks above start "
+          "at columns {}; entries of one mapping or list start in the same column",
+          line_index + 1, column, fmt::join(above, ", "));
+    }
+    return fmt::format(
+        "probably wrong indentation at line {}, or a list item ('- ') where a "
+        "key was expected (or the other way round)",
+        line_index + 1);
+  }
+  if (msg.find("illegal map value") != std::string::npos) {
+    const auto prior =
+        previous_line == 0 ? std::vector<std::size_t>{} : content_columns(lines[previous_line - 1]);
+    if (!prior.empty() && column > prior.back()) {
+      return fmt::format(
+          "probably wrong indentation: line {} starts at column {}, deeper than line {} (column "
+          "{}), so it reads as the continuation of that line's value",
+          line_index + 1, column, previous_line, prior.back());
+    }
+    return "a ':' followed by a space where no key can start: a value that contains ': ' must be "
+           "quoted ('...' or \"...\")";
+  }
+  return "";
+}
+
+}  // namespace
+
 ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> source, std::string path)
     : node_(std::move(node)), source_(std::move(source)), path_(std::move(path)) {}
 
@@ -226,7 +327,13 @@ ConfigNode ConfigNode::load_string(const std::string& text, const std::string& s
     if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     return ConfigNode(root, source, "");
   } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}: {}", mark_location(source_name, e.mark), printable(e.msg)));
+    const std::string hint = syntax_hint(text, e);
+    if (hint.empty()) {
+      throw ConfigError(
+          fmt::format("{}: {}", mark_location(source_name, e.mark), printable(e.msg)));
+    }
+    throw ConfigError(fmt::format("{}: {} (YAML parser: {})", mark_location(source_name, e.mark),
+                                  hint, printable(e.msg)));
   }
 }
 

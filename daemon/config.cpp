@@ -1,15 +1,19 @@
 #include "daemon/config.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <net/if.h>
+#include <netdb.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -17,10 +21,15 @@
 #include <set>
 #include <stdexcept>
 
+#include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
 #include "daemon/output_registry.hpp"
-#include "realtime/sample.hpp"
 #include "detect/factory.hpp"
+#include "detect/rig_options.hpp"
+#include "io/modbus/modbus_config.hpp"
+#include "io/modbus/modbus_link.hpp"
+#include "realtime/sample.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -95,6 +104,41 @@ dsp::FeatureParams parse_features(const config::ConfigNode& node) {
   return params;
 }
 
+// Leak sizes as a rig engineer reads them: `min_leak: 0.03 l/min/MPa` (the detectors' options
+// are in m^3/(s Pa)). The value is rewritten in place as its SI number, so the detector reads it
+// as before and its range errors still point at the field.
+void convert_leak_sizes(const config::ConfigNode& options) {
+  if (!options.is_map()) return;
+  constexpr std::string_view kUnit = "l/min/MPa";
+  for (const auto& [key, value] : options.entries()) {
+    if (!value.is_scalar()) continue;
+    const std::string text = value.as_string();
+    const auto unit = text.find(kUnit);
+    if (unit == std::string::npos) continue;
+    if (key != "design_leak" && key != "min_leak") {
+      value.fail(
+          fmt::format("{} is not a leak size (l/min/MPa applies to design_leak and "
+                      "min_leak)",
+                      key));
+    }
+    std::string number = text.substr(0, unit);
+    while (!number.empty() && number.back() == ' ') number.pop_back();
+    const bool unit_last = text.find_first_not_of(' ', unit + kUnit.size()) == std::string::npos;
+    double lpm_per_mpa = 0.0;
+    const auto [end, error] =
+        std::from_chars(number.data(), number.data() + number.size(), lpm_per_mpa);
+    if (number.empty() || error != std::errc() || end != number.data() + number.size() ||
+        !unit_last || !std::isfinite(lpm_per_mpa)) {
+      value.fail(
+          fmt::format("expected a number followed by l/min/MPa (e.g. 0.03 l/min/MPa), got "
+                      "'{}'",
+                      text));
+    }
+    YAML::Node scalar = value.yaml();  // shares the document's node: the detector sees SI
+    scalar = fmt::format("{:.17g}", units::cubic_metres_per_second_pascal(lpm_per_mpa));
+  }
+}
+
 pipeline::AlarmSettings parse_alarm(const config::ConfigNode& node) {
   node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching"});
   pipeline::AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
@@ -145,9 +189,29 @@ detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
   return spec;
 }
 
+// A detector option that restates a value of the actuator's `rig:` overrides it: valid, but the
+// two places may disagree, so say where both are.
+void warn_restated(const pipeline::ActuatorConfig& actuator, const config::ConfigNode& rig_node,
+                   std::vector<std::string>& warnings) {
+  if (!actuator.detector_options) return;
+  for (const auto& restated :
+       detect::restated_rig_values(*actuator.detector_options, actuator.rig)) {
+    std::string places;
+    for (const auto& key : restated.rig_keys) {
+      if (!places.empty()) places += ", ";
+      places += fmt::format("{} at {}", key, rig_node.at(key).location());
+    }
+    warnings.push_back(fmt::format(
+        "{}: {}: actuator '{}': also given in its rig: ({}); the detector uses this option. Give "
+        "the value once, in rig:",
+        restated.option.location(), restated.option.path(), actuator.name, places));
+  }
+}
+
 pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
-                                        std::set<std::string>& names) {
-  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers"});
+                                        std::set<std::string>& names,
+                                        std::vector<std::string>& warnings) {
+  node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers", "rig"});
   pipeline::ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
@@ -181,12 +245,18 @@ pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const Da
       detector->expect_keys({"kind", "options"});
       actuator.detector = detector->get_string("kind", "default");
       actuator.detector_options = detector->find("options");
+      if (actuator.detector_options) convert_leak_sizes(*actuator.detector_options);
     }
     const auto kinds = detect::detector_kinds();
     if (std::find(kinds.begin(), kinds.end(), actuator.detector) == kinds.end()) {
       detector->fail(fmt::format("unknown detector '{}' (known: {})", actuator.detector,
                                  fmt::join(kinds, ", ")));
     }
+  }
+  const auto rig = node.find("rig");
+  if (rig) {
+    pipeline::apply_rig(actuator, sim::read_rig(*rig));
+    warn_restated(actuator, *rig, warnings);
   }
   if (auto alarm = node.find("alarm")) {
     actuator.alarm = parse_alarm(*alarm);
@@ -275,7 +345,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
   std::set<std::string> actuator_names;
   const auto actuators = root.at("actuators");
   for (const auto& node : actuators.items()) {
-    config.actuators.push_back(parse_actuator(node, config, actuator_names));
+    config.actuators.push_back(parse_actuator(node, config, actuator_names, config.warnings));
   }
   if (config.actuators.empty()) actuators.fail("at least one actuator is needed");
 
@@ -399,7 +469,8 @@ void check_channels(const DaemonConfig& config,
                                static_cast<double>(group ? group->period_ns : 2'000'000) / 1e9;
     try {
       detect::make_detector(actuator.detector, signals, hop_seconds,
-                            actuator.detector_options ? &*actuator.detector_options : nullptr);
+                            actuator.detector_options ? &*actuator.detector_options : nullptr,
+                            &actuator.rig);
     } catch (const std::invalid_argument& e) {
       throw config::ConfigError(
           fmt::format("{}: actuator '{}': {}", config.source, actuator.name, e.what()));
@@ -555,6 +626,91 @@ void check_devices(const DaemonConfig& config) {
   }
 }
 
+namespace {
+
+// Connects to host:port within `timeout_ms`; empty on success, else why not.
+std::string tcp_connect_problem(const std::string& host, int port, int timeout_ms) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  if (const int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0) {
+    return fmt::format("cannot resolve '{}': {}", host, ::gai_strerror(rc));
+  }
+  std::string problem = "no address";
+  for (const addrinfo* a = found; a != nullptr; a = a->ai_next) {
+    const int fd =
+        ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
+    if (fd < 0) {
+      problem = std::strerror(errno);
+      continue;
+    }
+    int error = ::connect(fd, a->ai_addr, a->ai_addrlen) == 0 ? 0 : errno;
+    if (error == EINPROGRESS) {
+      pollfd waiting{fd, POLLOUT, 0};
+      const int ready = ::poll(&waiting, 1, timeout_ms);
+      socklen_t length = sizeof(error);
+      if (ready == 1) {
+        ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &length);
+      } else {
+        error = ETIMEDOUT;
+      }
+    }
+    ::close(fd);
+    if (error == 0) {
+      ::freeaddrinfo(found);
+      return "";
+    }
+    problem = error == ETIMEDOUT ? fmt::format("no answer within {} ms", timeout_ms)
+                                 : std::string(std::strerror(error));
+  }
+  ::freeaddrinfo(found);
+  return problem;
+}
+
+// `check-config`'s network check of a peer written at `node` (a driver or output mapping):
+// `problem` is why it does not answer, empty when it does.
+void check_peer(const config::ConfigNode& node, const std::string& host, int port,
+                std::string_view what, const std::string& problem) {
+  if (problem.empty()) return;
+  const auto where = node.find("host");
+  (where ? *where : node)
+      .fail(fmt::format("{} {}:{} does not answer: {} (is it on, and is this the right "
+                        "address? --no-peers leaves this check out)",
+                        what, host, port, problem));
+}
+
+}  // namespace
+
+void check_peers(const DaemonConfig& config) {
+  constexpr int kConnectTimeoutMs = 3000;
+  // A Modbus device must answer a read (a TCP connection alone can be a gateway's, or a
+  // firewall's that accepts everything); the alarm output and the broker must accept one.
+  for (const auto& driver : config.drivers) {
+    if (!driver.node || driver.type != "modbus") continue;
+    const auto modbus = io::modbus::parse_modbus_config(*driver.node);
+    if (!modbus.tcp) continue;
+    check_peer(*driver.node, modbus.tcp->host, modbus.tcp->port, "Modbus device",
+               io::modbus::unanswered(modbus));
+  }
+  for (const auto& node : config.outputs) {
+    const std::string type = node.get_string("type");
+    if (type == "modbus" && node.get_string("transport", "tcp") == "tcp") {
+      const std::string host = node.get_string("host");
+      const int port = static_cast<int>(node.get_int("port", 502, 1, 65535));
+      check_peer(node, host, port, "Modbus alarm output",
+                 tcp_connect_problem(host, port, kConnectTimeoutMs));
+    } else if (type == "mqtt") {
+      const std::string host = node.get_string("host", "127.0.0.1");
+      const int port =
+          static_cast<int>(node.get_int("port", node.has("tls") ? 8883 : 1883, 1, 65535));
+      check_peer(node, host, port, "MQTT broker",
+                 tcp_connect_problem(host, port, kConnectTimeoutMs));
+    }
+  }
+}
+
 DaemonConfig check_config(const std::string& path, const Preflight& preflight) {
   DaemonConfig config = load_config(path);
   check_paths(config);
@@ -568,6 +724,13 @@ DaemonConfig check_config(const std::string& path, const Preflight& preflight) {
   }
   check_channels(config, driver_channels);
   for (const auto& node : config.outputs) make_output(node);
+  for (const auto& driver : config.drivers) {
+    if (driver.type != "modbus" || !driver.node) continue;
+    const auto modbus = io::modbus::parse_modbus_config(*driver.node);
+    config.warnings.insert(config.warnings.end(), modbus.warnings.begin(), modbus.warnings.end());
+  }
+  // Last: the peers are only worth asking once everything else in the file is right.
+  if (preflight.peers) check_peers(config);
   return config;
 }
 

@@ -29,6 +29,9 @@ struct Preflight {
   // The metrics address and port can be bound now (nothing else listens there). A running
   // daemon's reload leaves this out: it holds the port itself.
   bool port = true;
+  // Network peers (Modbus TCP devices, MQTT brokers) accept a TCP connection now. Only
+  // `leakmon check-config`: the daemon starts without them and reconnects when they come.
+  bool peers = false;
 };
 
 // Full validation, the one `leakmon check-config` and `leakmon run` (and SIGHUP) share, so that
@@ -42,6 +45,7 @@ DaemonConfig check_config(const std::string& path, const Preflight& preflight = 
 void check_paths(const DaemonConfig& config);
 void check_port(const DaemonConfig& config);
 void check_devices(const DaemonConfig& config);
+void check_peers(const DaemonConfig& config);
 
 // Checks actuator channel references and group sizes against the channels the built drivers
 // offer (`driver_channels[i]` belongs to `config.drivers[i]`). Throws ConfigError.

@@ -18,6 +18,7 @@
 #include "daemon/routes.hpp"
 #include "http/http_router.hpp"
 #include "pipeline/event_log.hpp"
+#include "pipeline/learning_report.hpp"
 #include "views/metrics_text.hpp"
 #include "views/status_json.hpp"
 
@@ -107,6 +108,7 @@ void Daemon::start() {
   config_ = check_config(config_path_);
   spdlog::info("configuration {}: {} driver(s), {} sampling group(s), {} actuator(s)", config_path_,
                config_.drivers.size(), config_.groups.size(), config_.actuators.size());
+  for (const auto& warning : config_.warnings) spdlog::warn("{}", warning);
 
   // Threads inherit the blocked control signals: only the main thread receives them.
   const sigset_t signals = control_signals();
@@ -188,6 +190,16 @@ void Daemon::start() {
     }
     spdlog::info("learned state kept under {} (saved every {} s and at shutdown)",
                  config_.state.directory, config_.state.save_seconds);
+  }
+
+  // Which detector runs for each actuator, and how long it learns before it can raise alarms.
+  for (const auto& status : worker_->status()) {
+    for (const auto& actuator : config_.actuators) {
+      if (actuator.name == status.name) {
+        spdlog::info("{}", pipeline::detector_line(actuator, status));
+      }
+    }
+    learning_[status.name] = status.learning;
   }
 
   {
@@ -355,6 +367,12 @@ void Daemon::housekeeping(std::int64_t now_ns) {
     save_state(with_trend);
     last_state_save_ns_ = now_ns;
     if (with_trend) last_trend_save_ns_ = now_ns;
+  }
+  // The end of each actuator's learning, once (a reload that relearns starts it again).
+  for (const auto& status : worker_->status()) {
+    bool& learning = learning_[status.name];
+    if (learning && !status.learning) spdlog::info("{}", pipeline::learning_line(status));
+    learning = status.learning;
   }
   // Overruns: at most one warning (and one event) per second for all groups.
   if (now_ns - last_overrun_warning_ns_ >= kSecond) {

@@ -115,6 +115,8 @@ class Daemon {
 
   // Housekeeping state (main thread only).
   std::vector<std::uint64_t> reported_overruns_;
+  // Actuators whose detector was still learning at the last look, to log when learning ends.
+  std::map<std::string, bool> learning_;
   std::vector<DriverWatch> driver_watch_;
   std::int64_t last_overrun_warning_ns_ = 0;
   std::int64_t last_watchdog_ns_ = 0;

@@ -24,15 +24,14 @@ constexpr double kFitPressure = 30e3;
 // A step whose new level cannot be read from two clusters by then (the programme rested on one
 // side only): the level from the holds' mean, the learned asymmetry removed.
 constexpr double kGiveUpSeconds = 120.0;
-constexpr std::size_t kFixedValues = 17;
 
 }  // namespace
 
 ChamberSupplyTracker::ChamberSupplyTracker(std::size_t capacity)
-    : holds_(std::max<std::size_t>(capacity, 2 * kLearnPerSide)), scratch_(holds_.size()) {}
+    : holds_(std::max<std::size_t>(capacity, 2 * kLearnPerSide)), scratch_(holds_.capacity()) {}
 
 void ChamberSupplyTracker::reset() {
-  next_ = count_ = 0;
+  holds_.clear();
   still_hops_ = used_hops_ = 0;
   sum_ = 0.0;
   last_t_ = hold_start_ = kMissing;
@@ -42,17 +41,13 @@ void ChamberSupplyTracker::reset() {
 }
 
 void ChamberSupplyTracker::resume_after_gap() {
-  next_ = count_ = 0;
+  holds_.clear();
   still_hops_ = used_hops_ = 0;
   sum_ = 0.0;
   last_t_ = hold_start_ = kMissing;
   last_fit_t_ = step_time_ = kMissing;
   // A step seen before the gap still needs its level: from the holds after the gap.
   if (awaiting()) awaiting_since_ = awaiting_from_t_ = -1e300;
-}
-
-const ChamberSupplyTracker::Hold& ChamberSupplyTracker::hold_at(std::size_t age) const {
-  return holds_[(next_ + holds_.size() - 1 - age) % holds_.size()];
 }
 
 ChamberSupplyTracker::Event ChamberSupplyTracker::add(double t, double pressure, bool still) {
@@ -87,9 +82,7 @@ bool ChamberSupplyTracker::fits(double level, double mid) const {
 }
 
 void ChamberSupplyTracker::on_hold(const Hold& hold) {
-  holds_[next_] = hold;
-  next_ = (next_ + 1) % holds_.size();
-  count_ = std::min(count_ + 1, holds_.size());
+  holds_.push(hold);
   if (!active()) return;
   if (!awaiting()) {
     if (fits(hold.level, mid_)) {
@@ -116,8 +109,9 @@ void ChamberSupplyTracker::on_hold(const Hold& hold) {
       if (hold.t - awaiting_from_t_ < kGiveUpSeconds) return;
       double sum = 0.0;
       std::size_t n = 0;
-      for (std::size_t age = 0; age < count_ && hold_at(age).t > awaiting_since_; ++age) {
-        sum += hold_at(age).level;
+      for (std::size_t age = 0; age < holds_.size() && holds_.newest(age).t > awaiting_since_;
+           ++age) {
+        sum += holds_.newest(age).level;
         ++n;
       }
       if (n == 0) return;
@@ -126,15 +120,16 @@ void ChamberSupplyTracker::on_hold(const Hold& hold) {
     }
     // Misfit: drop the oldest hold of the window.
     double oldest = hold.t;
-    for (std::size_t age = 0; age < count_ && hold_at(age).t > awaiting_since_; ++age) {
-      oldest = hold_at(age).t;
+    for (std::size_t age = 0; age < holds_.size() && holds_.newest(age).t > awaiting_since_;
+         ++age) {
+      oldest = holds_.newest(age).t;
     }
     awaiting_since_ = oldest;
   }
   // Holds after the step that happened to fit the old clusters too moved step_time() past the
   // step; it began after the newest hold (before it was seen) that fits the old clusters only.
-  for (std::size_t age = 0; age < count_; ++age) {
-    const Hold& h = hold_at(age);
+  for (std::size_t age = 0; age < holds_.size(); ++age) {
+    const Hold& h = holds_.newest(age);
     if (h.t > awaiting_from_t_) continue;
     if (h.t <= step_time_ - kGiveUpSeconds) break;
     if (fits(h.level, old_mid) && !fits(h.level, mid_)) {
@@ -153,8 +148,8 @@ void ChamberSupplyTracker::on_hold(const Hold& hold) {
 ChamberSupplyTracker::Clusters ChamberSupplyTracker::clusters_since(double since,
                                                                     std::size_t min_per_side) {
   std::size_t n = 0;
-  for (std::size_t age = 0; age < count_ && hold_at(age).t > since; ++age) {
-    scratch_[n++] = hold_at(age).level;
+  for (std::size_t age = 0; age < holds_.size() && holds_.newest(age).t > since; ++age) {
+    scratch_[n++] = holds_.newest(age).level;
   }
   Clusters c;
   if (n < 2 * min_per_side) return c;
@@ -181,75 +176,65 @@ bool ChamberSupplyTracker::learn() {
   const Clusters c = clusters_since(-1e300, kLearnPerSide);
   if (!c.ok) return false;
   double near = 1e300, far = 0.0, sum = 0.0;
-  for (std::size_t age = 0; age < count_; ++age) {
-    const double d = std::abs(hold_at(age).level - c.mid);
+  for (std::size_t age = 0; age < holds_.size(); ++age) {
+    const double d = std::abs(holds_.newest(age).level - c.mid);
     near = std::min(near, d);
     far = std::max(far, d);
-    sum += hold_at(age).level;
+    sum += holds_.newest(age).level;
   }
   // Two clusters clearly apart: the gap between them (2 near) wider than either.
   if (!(2.0 * near > far - near)) return false;
   learned_mid_ = mid_ = c.mid;
   near_ = near;
   far_ = far;
-  learned_offset_ = sum / static_cast<double>(count_) - c.mid;
-  last_fit_t_ = hold_at(0).t;
+  learned_offset_ = sum / static_cast<double>(holds_.size()) - c.mid;
+  last_fit_t_ = holds_.newest(0).t;
   return true;
 }
 
-std::vector<double> ChamberSupplyTracker::export_values() const {
-  std::vector<double> v = {static_cast<double>(next_),
-                           static_cast<double>(count_),
-                           static_cast<double>(still_hops_),
-                           static_cast<double>(used_hops_),
-                           sum_,
-                           last_t_,
-                           hold_start_,
-                           learned_mid_,
-                           near_,
-                           far_,
-                           learned_offset_,
-                           mid_,
-                           last_fit_t_,
-                           step_time_,
-                           awaiting_since_,
-                           awaiting_from_t_,
-                           static_cast<double>(pending_)};
-  v.reserve(kFixedValues + 2 * holds_.size());
-  for (const auto& h : holds_) v.insert(v.end(), {h.t, h.level});
-  return v;
+void ChamberSupplyTracker::save(DetectorState& state, std::string_view prefix) const {
+  save_ring(state, state_key(prefix, "holds"), holds_, kHoldFields);
+  const auto key = [&](std::string_view name) { return state_key(prefix, name); };
+  state.put_count(key("hold.still_hops"), still_hops_);
+  state.put_count(key("hold.used_hops"), used_hops_);
+  state.put(key("hold.sum"), sum_);
+  state.put(key("hold.last_t"), last_t_);
+  state.put(key("hold.start"), hold_start_);
+  state.put(key("learned_mid"), learned_mid_);
+  state.put(key("near"), near_);
+  state.put(key("far"), far_);
+  state.put(key("learned_offset"), learned_offset_);
+  state.put(key("mid"), mid_);
+  state.put(key("last_fit_t"), last_fit_t_);
+  state.put(key("step_time"), step_time_);
+  state.put(key("awaiting_since"), awaiting_since_);
+  state.put(key("awaiting_from_t"), awaiting_from_t_);
+  state.put_count(key("pending"), static_cast<std::size_t>(pending_));
 }
 
-void ChamberSupplyTracker::import_values(const std::vector<double>& v) {
-  if (v.size() != kFixedValues + 2 * holds_.size()) {
-    throw StateError("chamber supply: wrong number of values");
+void ChamberSupplyTracker::restore(const DetectorState& state, std::string_view prefix) {
+  restore_ring(state, state_key(prefix, "holds"), holds_, kHoldFields);
+  const auto key = [&](std::string_view name) { return state_key(prefix, name); };
+  still_hops_ = state.get_count(key("hold.still_hops"));
+  used_hops_ = state.get_count(key("hold.used_hops"));
+  if (used_hops_ > still_hops_) throw StateError("chamber supply: more used hops than still ones");
+  sum_ = state.get(key("hold.sum"));
+  last_t_ = state.get(key("hold.last_t"));
+  hold_start_ = state.get(key("hold.start"));
+  learned_mid_ = state.get(key("learned_mid"));
+  near_ = state.get(key("near"));
+  far_ = state.get(key("far"));
+  learned_offset_ = state.get(key("learned_offset"));
+  mid_ = state.get(key("mid"));
+  last_fit_t_ = state.get(key("last_fit_t"));
+  step_time_ = state.get(key("step_time"));
+  awaiting_since_ = state.get(key("awaiting_since"));
+  awaiting_from_t_ = state.get(key("awaiting_from_t"));
+  const std::size_t pending = state.get_count(key("pending"));
+  if (pending > static_cast<std::size_t>(Event::estimated)) {
+    throw StateError("chamber supply: unknown pending event");
   }
-  auto count = [&](std::size_t i, std::size_t limit) {
-    if (!(v[i] >= 0.0 && v[i] <= static_cast<double>(limit)) || v[i] != std::floor(v[i])) {
-      throw StateError("chamber supply: a count out of range");
-    }
-    return static_cast<std::size_t>(v[i]);
-  };
-  next_ = count(0, holds_.size() - 1);
-  count_ = count(1, holds_.size());
-  still_hops_ = count(2, static_cast<std::size_t>(1) << 40);
-  used_hops_ = count(3, still_hops_);
-  sum_ = v[4];
-  last_t_ = v[5];
-  hold_start_ = v[6];
-  learned_mid_ = v[7];
-  near_ = v[8];
-  far_ = v[9];
-  learned_offset_ = v[10];
-  mid_ = v[11];
-  last_fit_t_ = v[12];
-  step_time_ = v[13];
-  awaiting_since_ = v[14];
-  awaiting_from_t_ = v[15];
-  pending_ = static_cast<Event>(count(16, 2));
-  for (std::size_t i = 0; i < holds_.size(); ++i) {
-    holds_[i] = {v[kFixedValues + 2 * i], v[kFixedValues + 2 * i + 1]};
-  }
+  pending_ = static_cast<Event>(pending);
 }
 
 }  // namespace leakmon::detect

@@ -10,9 +10,11 @@
 #pragma once
 
 #include <cstddef>
+#include <string_view>
 #include <vector>
 
 #include "detect/detector.hpp"
+#include "detect/ring.hpp"
 
 namespace leakmon::detect {
 
@@ -41,14 +43,16 @@ class ChamberSupplyTracker {
   void reset();
   // The data resumes on another clock: holds and times are forgotten, the geometry stays.
   void resume_after_gap();
-  // Everything as one list of numbers (DetectorState); import throws StateError on a mismatch.
-  std::vector<double> export_values() const;
-  void import_values(const std::vector<double>& values);
+  // Everything under `prefix.` (DetectorState); restore() throws StateError on a mismatch.
+  void save(DetectorState& state, std::string_view prefix) const;
+  void restore(const DetectorState& state, std::string_view prefix);
 
  private:
   struct Hold {
     double t, level;
   };
+  static constexpr std::array<RecordField<Hold>, 2> kHoldFields = {
+      record_field<&Hold::t>("t"), record_field<&Hold::level>("level")};
   struct Clusters {
     bool ok = false;
     double mid = kMissing;
@@ -58,10 +62,8 @@ class ChamberSupplyTracker {
   bool fits(double level, double mid) const;
   // The two clusters of the holds ending after `since`, each with at least `min_per_side`.
   Clusters clusters_since(double since, std::size_t min_per_side);
-  const Hold& hold_at(std::size_t age) const;  // 0: newest
 
-  std::vector<Hold> holds_;  // ring, sized at construction
-  std::size_t next_ = 0, count_ = 0;
+  Ring<Hold> holds_;
   std::vector<double> scratch_;  // sorting buffer, sized at construction
   // The hold being formed.
   std::size_t still_hops_ = 0, used_hops_ = 0;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "detect/legacy_state.hpp"
 #include "dsp/wavelet.hpp"
 
 namespace leakmon::detect {
@@ -45,32 +46,46 @@ double dot(const std::array<double, N>& filter, const double* samples) {
   return sum;
 }
 
-IndexCusumOptions test_options(const DetailXcorrOptions& o, bool correlation) {
-  IndexCusumOptions test = o.test;
-  // The feature is a ratio: the supply's and the oil's effects on the index's size cancel in it;
-  // what is left of them the regression and the drift reference follow.
-  test.supply_exponent = 0.0;
-  test.temperature_prior = 0.0;
+// The test's physics: shifts in the feature's units (oriented so that a leak lowers it), no
+// supply exponent and no temperature (the feature is a ratio: the supply's and the oil's
+// effects on the index's size cancel in it; what is left of them the regression and the drift
+// reference follow).
+//
+// The shifts are ln(1 - (1 - e^-shift)), and the test sees ln(e^feature): this detector first
+// ran on the index's test with exp(feature) as its "index" and the shift as a relative drop of
+// it; the round trips, which move the values by an ulp or so, are kept so that its events stay
+// the same to the byte (issue 26). Issue 23 may drop them.
+FeaturePhysics xcorr_physics(const DetailXcorrOptions& o, bool correlation) {
   const double design = correlation ? o.design_shift_correlation : o.design_shift_ratio;
   const double floor = correlation ? o.min_shift_correlation : o.min_shift_ratio;
-  // The test looks for a drop of log(index) by -log(1 - design_drop); the "index" handed to it
-  // is exp(feature), oriented so that a leak lowers it.
-  test.design_drop = -std::expm1(-design);
-  test.min_drop = -std::expm1(-floor);
-  return test;
+  FeaturePhysics physics;
+  physics.design_shift = std::log1p(std::expm1(-design));
+  physics.null_shift = std::log1p(std::expm1(-floor));
+  physics.supply_exponent = 0.0;
+  physics.uses_temperature = false;
+  physics.temperature_prior = 0.0;
+  return physics;
 }
 
-constexpr int kStateVersion = 1;
+double as_test_value(double oriented) {
+  const double e = std::exp(oriented);
+  return e > 0.0 ? std::log(e) : kMissing;
+}
+
+std::size_t window_hops_of(const DetailXcorrOptions& o) {
+  return std::clamp<std::size_t>(o.window_hops, 1, DetailXcorrDetector::kMaxWindowHops);
+}
 
 }  // namespace
 
 DetailXcorrDetector::DetailXcorrDetector(const DetailXcorrOptions& options, double hop_seconds)
     : options_(options),
       hop_seconds_(hop_seconds),
-      correlation_(options.test.use_p1 && options.test.use_p2),
-      use_p2_alone_(!options.test.use_p1 && options.test.use_p2),
-      test_(test_options(options, options.test.use_p1 && options.test.use_p2), hop_seconds) {
-  options_.window_hops = std::clamp<std::size_t>(options_.window_hops, 1, kMaxWindowHops);
+      correlation_(options.use_p1 && options.use_p2),
+      use_p2_alone_(!options.use_p1 && options.use_p2),
+      hops_(window_hops_of(options)),
+      test_(options, xcorr_physics(options, options.use_p1 && options.use_p2), hop_seconds) {
+  options_.window_hops = hops_.capacity();
   const auto& db8 = dsp::wavelet("db8");
   const std::span<const double> lo = db8.dec_lo, hi = db8.dec_hi;
   std::array<double, kTaps> two{}, three{}, scratch{};
@@ -86,15 +101,13 @@ DetailXcorrDetector::DetailXcorrDetector(const DetailXcorrOptions& options, doub
 
 void DetailXcorrDetector::restart_filters() {
   primed_ = 0;
-  hops_filled_ = 0;
-  hop_next_ = 0;
+  hops_.clear();
 }
 
 void DetailXcorrDetector::reset() {
   restart_filters();
   a_ = History{};
   b_ = History{};
-  hops_.fill(HopSums{});
   last_t_ = kMissing;
   test_.reset();
 }
@@ -106,11 +119,10 @@ void DetailXcorrDetector::resume_after_gap() {
 }
 
 double DetailXcorrDetector::feature() const {
-  if (hops_filled_ < options_.window_hops) return kMissing;
+  if (!hops_.full()) return kMissing;
   HopSums total;
-  // Oldest first, so that an imported state (stored oldest first) sums in the same order.
-  for (std::size_t i = 0; i < options_.window_hops; ++i) {
-    const HopSums& h = hops_[(hop_next_ + i) % options_.window_hops];
+  for (std::size_t i = 0; i < hops_.size(); ++i) {
+    const HopSums& h = hops_.oldest(i);
     total.aa += h.aa;
     total.bb += h.bb;
     total.ab += h.ab;
@@ -168,83 +180,60 @@ Decision DetailXcorrDetector::update(const Observation& observation) {
     }
   }
   // A hop counts only when every one of its samples had a primed filter.
-  if (complete && primed_throughout) {
-    hops_[hop_next_] = sums;
-    hop_next_ = (hop_next_ + 1) % options_.window_hops;
-    if (hops_filled_ < options_.window_hops) ++hops_filled_;
-  }
+  if (complete && primed_throughout) hops_.push(sums);
   const double value = complete ? feature() : kMissing;
-
-  Observation inner = observation;
+  // A leak raises the correlation (less antiphase) and lowers the band ratio.
   const double oriented = correlation_ ? -value : value;
-  const double index = std::isnan(value) ? kMissing : std::exp(oriented);
-  inner.index_p1 = index;
-  inner.index_p2 = index;
   // The correlation hardly moves with the oil (about 1/30 of its block spread per kelvin) and the
   // drift reference follows what does. With `temp` the test would fit a temperature coefficient
   // on what learning saw and stop following the slope: in warm-ups that learned on the steepest
-  // warming that raised false alarms (2 in 0.9 h, docs/detection.md). So `temp` is not used.
-  inner.temp = kMissing;
-  Decision decision = test_.update(inner);
+  // warming that raised false alarms (2 in 0.9 h, docs/detection.md). So `temp` is not used
+  // (FeaturePhysics::uses_temperature).
+  const FeatureTest::Verdict verdict =
+      test_.update(observation, std::isnan(value) ? kMissing : as_test_value(oriented));
+  Decision decision;
+  decision.learning = verdict.learning;
+  decision.learning_hops_left = verdict.learning_hops_left;
+  decision.score = verdict.score;
   // For the operator: the paper's index of the chamber, not the feature's scale.
   decision.index = use_p2_alone_ ? observation.index_p2 : observation.index_p1;
-  decision.baseline = kMissing;
   return decision;
 }
 
 DetectorState DetailXcorrDetector::export_state() const {
   DetectorState state(std::string(name()), kStateVersion);
-  state.put_nested("test", test_.export_state());
+  test_.save(state, "test");
   auto history = [](const History& h) {
     return std::vector<double>(h.newest(), h.newest() + kTaps);
   };
   state.put("history_a", history(a_));
   state.put("history_b", history(b_));
   state.put_count("primed", primed_);
-  std::vector<double> hops;
-  for (std::size_t i = 0; i < options_.window_hops; ++i) {
-    const HopSums& h = hops_[(hop_next_ + i) % options_.window_hops];  // oldest first
-    hops.insert(hops.end(), {h.aa, h.bb, h.ab, h.e1, h.e3});
-  }
-  state.put("hops", hops);
-  state.put_count("hops_filled", hops_filled_);
+  save_ring(state, "hops", hops_, kHopFields);
   state.put("last_t", last_t_);
   return state;
 }
 
-void DetailXcorrDetector::import_state(const DetectorState& state) {
-  try {
-    state.expect(name(), kStateVersion);
-    test_.import_state(state.get_nested("test"));
+void DetailXcorrDetector::import_state(const DetectorState& saved) {
+  import_detector_state(*this, saved, kStateVersion, [this](const DetectorState& state) {
+    test_.restore(state, "test");
     const auto& history_a = state.get_list("history_a");
     const auto& history_b = state.get_list("history_b");
-    const auto& hops = state.get_list("hops");
-    if (history_a.size() != kTaps || history_b.size() != kTaps ||
-        hops.size() != 5 * options_.window_hops) {
-      throw StateError("detail_xcorr: filter history does not fit this configuration");
+    if (history_a.size() != kTaps || history_b.size() != kTaps) {
+      throw StateError("filter history does not fit this configuration");
     }
     const std::size_t primed = state.get_count("primed");
-    const std::size_t filled = state.get_count("hops_filled");
-    if (primed > kTaps || filled > options_.window_hops) {
-      throw StateError("detail_xcorr: filter position out of range");
-    }
+    if (primed > kTaps) throw StateError("filter position out of range");
     a_ = History{};
     b_ = History{};
     for (std::size_t i = 0; i < kTaps; ++i) {
       a_.push(history_a[i]);
       b_.push(history_b[i]);
     }
-    for (std::size_t i = 0; i < options_.window_hops; ++i) {
-      hops_[i] = {hops[5 * i], hops[5 * i + 1], hops[5 * i + 2], hops[5 * i + 3], hops[5 * i + 4]};
-    }
-    hop_next_ = 0;
     primed_ = primed;
-    hops_filled_ = filled;
+    restore_ring(state, "hops", hops_, kHopFields);
     last_t_ = state.get("last_t");
-  } catch (...) {
-    reset();
-    throw;
-  }
+  });
 }
 
 }  // namespace leakmon::detect

@@ -11,11 +11,11 @@
 //
 // The details are computed here, per sample, with the undecimated (a trous) db8 filters of
 // levels 1-3 on the hop's samples (Observation::p1_samples), summed over a sliding window of
-// `window_hops` hops (the index's 400 samples). The sequential test is IndexCusumDetector's,
-// run on exp(-correlation) (resp. exp(band ratio)) as its "index": the per-rig regression on the
-// load and the activity, the drift reference, the supply-step handling and the threshold from
-// the target false-alarm rate carry over; the feature's own scale replaces the index's physics
-// (no supply exponent; the oil temperature is not used, the drift reference follows it).
+// `window_hops` hops (the index's 400 samples). The feature goes to the sequential test
+// (FeatureTest: the per-rig regression on the load and the activity, the drift reference, the
+// supply-step handling, the threshold from the target false-alarm rate), oriented so that a leak
+// lowers it; its physics is its own scale (shifts in correlation or ln band ratio), no supply
+// exponent (a ratio), and no temperature (the drift reference follows the oil).
 #pragma once
 
 #include <array>
@@ -23,12 +23,15 @@
 #include <string_view>
 
 #include "detect/detector.hpp"
-#include "detect/index_cusum_detector.hpp"
+#include "detect/feature_test.hpp"
+#include "detect/ring.hpp"
 
 namespace leakmon::detect {
 
-struct DetailXcorrOptions {
-  IndexCusumOptions test;  // use_p1 / use_p2: the chambers acquired
+// use_p1 / use_p2: the chambers acquired. Blocks of two windows: the sliding feature's
+// neighbouring blocks then share little data.
+struct DetailXcorrOptions : FeatureTestOptions {
+  DetailXcorrOptions() { block_seconds = 1.6; }
   // Shift of the feature the CUSUM is tuned for and the shift that is never an alarm, in the
   // feature's units: correlation for two chambers (healthy block spread about 0.01; a 1e-12
   // leak raises it by about 0.005), band ratio [ln] for one (spread about 0.35, shift -0.13).
@@ -50,8 +53,8 @@ class DetailXcorrDetector final : public Detector {
   std::string_view name() const override { return "detail_xcorr"; }
   bool needs_hydraulic_mode() const override { return true; }
   Decision update(const Observation& observation) override;
-  double raise_threshold() const override { return test_.raise_threshold(); }
-  double clear_threshold() const override { return test_.clear_threshold(); }
+  double raise_threshold() const override { return FeatureTest::raise_threshold(); }
+  double clear_threshold() const override { return FeatureTest::clear_threshold(); }
   void reset() override;
   DetectorState export_state() const override;
   void import_state(const DetectorState& state) override;
@@ -60,6 +63,9 @@ class DetailXcorrDetector final : public Detector {
 
   bool uses_correlation() const { return correlation_; }
 
+  // The layout export_state() writes (legacy_state.hpp reads the ones before).
+  static constexpr int kStateVersion = 2;
+
  private:
   // Per-hop sums of the details: products of the two chambers' level-2 details, or the energy
   // of one chamber's levels 1-3.
@@ -67,6 +73,10 @@ class DetailXcorrDetector final : public Detector {
     double aa = 0.0, bb = 0.0, ab = 0.0;  // level 2: chamber a, chamber b, cross
     double e1 = 0.0, e3 = 0.0;            // levels 1 and 3 of chamber a
   };
+  static constexpr std::array<RecordField<HopSums>, 5> kHopFields = {
+      record_field<&HopSums::aa>("aa"), record_field<&HopSums::bb>("bb"),
+      record_field<&HopSums::ab>("ab"), record_field<&HopSums::e1>("e1"),
+      record_field<&HopSums::e3>("e3")};
   struct History {
     // Each sample written twice, so that the newest kTaps are contiguous.
     std::array<double, 2 * kTaps> samples{};
@@ -91,10 +101,9 @@ class DetailXcorrDetector final : public Detector {
   std::array<double, kTaps> level1_{}, level2_{}, level3_{};
   History a_, b_;
   std::size_t primed_ = 0;  // clean samples since the filters restarted (capped at kTaps)
-  std::array<HopSums, kMaxWindowHops> hops_{};
-  std::size_t hop_next_ = 0, hops_filled_ = 0;
+  Ring<HopSums> hops_;      // the window's hops (window_hops of them)
   double last_t_ = kMissing;
-  IndexCusumDetector test_;
+  FeatureTest test_;
 };
 
 }  // namespace leakmon::detect

@@ -195,3 +195,15 @@ bool DetectorState::operator==(const DetectorState& other) const {
 }
 
 }  // namespace leakmon::detect
+
+namespace leakmon::detect {
+
+std::string state_key(std::string_view prefix, std::string_view name) {
+  if (prefix.empty()) return std::string(name);
+  std::string key(prefix);
+  key += '.';
+  key += name;
+  return key;
+}
+
+}  // namespace leakmon::detect

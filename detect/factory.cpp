@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <initializer_list>
 #include <numbers>
-#include <span>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -13,6 +11,7 @@
 #include "detect/flow_balance_detector.hpp"
 #include "detect/fused_detector.hpp"
 #include "detect/index_cusum_detector.hpp"
+#include "detect/option_table.hpp"
 #include "detect/paper_baseline_detector.hpp"
 #include "sim/oil.hpp"
 
@@ -20,83 +19,60 @@ namespace leakmon::detect {
 
 namespace {
 
-constexpr double kMaxSeconds = 86400.0;
+// Option groups several kinds share, over any options struct with the members they name.
 
-bool has_pressure(const AvailableSignals& s) { return s.p1 || s.p2; }
-bool has_all(const AvailableSignals& s) { return s.p1 && s.p2 && s.u && s.x; }
-
-// Reads an optional double option into `value`, range-checked at the option's location.
-void read(const config::ConfigNode* options, std::string_view key, double& value, double lo,
-          double hi) {
-  if (options != nullptr) value = options->get_double(key, value, lo, hi);
+template <class O>
+std::vector<Option<O>> learning_options() {
+  return {number_option<O>("settle_seconds", 0.0, kMaxOptionSeconds,
+                           "start-up transient ignored before learning [s]",
+                           [](O& o) -> double& { return o.learning.settle_seconds; }),
+          number_option<O>("learn_seconds", 1.0, kMaxOptionSeconds,
+                           "healthy behaviour of this rig learned over this long [s]",
+                           [](O& o) -> double& { return o.learning.learn_seconds; })};
 }
 
-// The rig table holds bore and rod (A = pi/4 (D^2 - d^2)); a configured piston_area keeps the
-// rod and sets the bore that gives that area.
-void set_piston_area(sim::Parameters& rig, double area) {
-  rig.D = std::sqrt(4.0 * area / std::numbers::pi + rig.d * rig.d);
+template <class O>
+std::vector<Option<O>> false_alarm_options() {
+  return {number_option<O>("false_alarms_per_hour", 1e-6, 100.0,
+                           "target false-alarm rate: sets the CUSUM threshold",
+                           [](O& o) -> double& { return o.false_alarms_per_hour; }),
+          number_option<O>("block_seconds", 0.01, 60.0, "length of a judged block [s]",
+                           [](O& o) -> double& { return o.block_seconds; })};
 }
 
-void read_learning(const config::ConfigNode* options, LearningSchedule& learning) {
-  read(options, "settle_seconds", learning.settle_seconds, 0.0, kMaxSeconds);
-  read(options, "learn_seconds", learning.learn_seconds, 1.0, kMaxSeconds);
+template <class O>
+std::vector<Option<O>> supply_options() {
+  return {number_option<O>("supply_pressure", 1e5, 1e9,
+                           "configured supply [Pa], used until one is measured",
+                           [](O& o) -> double& { return o.rig.ps; }),
+          number_option<O>("tank_pressure", 0.0, 1e8, "tank pressure [Pa]",
+                           [](O& o) -> double& { return o.rig.pt; })};
 }
 
-using KeyList = std::span<const std::string_view>;
-constexpr std::string_view kLearningKeysData[] = {"settle_seconds", "learn_seconds"};
-constexpr std::string_view kIndexKeysData[] = {
-    "design_drop",          "false_alarms_per_hour",   "block_seconds",
-    "supply_pressure",      "tank_pressure",           "min_drop",
-    "temperature_prior",    "temperature_prior_sigma", "drift_guard_seconds",
-    "drift_window_seconds", "supply_settle_seconds",   "oil_grade",
-    "oil_viscosity_40",     "oil_viscosity_100"};
-constexpr std::string_view kFlowKeysData[] = {"supply_pressure",
-                                              "tank_pressure",
-                                              "command_full_scale",
-                                              "valve_coefficient",
-                                              "valve_coefficient_uncertainty",
-                                              "piston_area",
-                                              "rest_speed",
-                                              "design_leak",
-                                              "false_alarms_per_hour",
-                                              "block_seconds",
-                                              "sizing_seconds",
-                                              "min_leak",
-                                              "drift_guard_seconds",
-                                              "drift_window_seconds",
-                                              "estimate_supply",
-                                              "oil_grade",
-                                              "oil_viscosity_40",
-                                              "oil_viscosity_100"};
-constexpr std::string_view kPaperKeysData[] = {"baseline_quantile", "window_seconds",
-                                               "raise_fraction", "clear_fraction", "channel"};
-constexpr std::string_view kXcorrKeysData[] = {
-    "design_shift",         "min_shift",     "false_alarms_per_hour", "block_seconds",
-    "supply_pressure",      "tank_pressure", "drift_guard_seconds",   "drift_window_seconds",
-    "supply_settle_seconds"};
-constexpr KeyList kXcorrKeys = kXcorrKeysData;
-constexpr double kXcorrBlockSeconds = 1.6;
-constexpr KeyList kLearningKeys = kLearningKeysData, kIndexKeys = kIndexKeysData,
-                  kFlowKeys = kFlowKeysData, kPaperKeys = kPaperKeysData;
+template <class O>
+std::vector<Option<O>> drift_options(double min_window) {
+  return {
+      number_option<O>("drift_guard_seconds", 0.0, 3600.0,
+                       "the drift reference's window ends this long ago [s]",
+                       [](O& o) -> double& { return o.drift_guard_seconds; }),
+      number_option<O>("drift_window_seconds", min_window, 3600.0,
+                       min_window > 0.0
+                           ? "length of the drift reference's window [s]"
+                           : "length of the drift reference's window [s]; 0: no drift following",
+                       [](O& o) -> double& { return o.drift_window_seconds; })};
+}
 
-// Rejects keys outside the union of the given groups, at the key's file:line:column.
-void expect_keys(const config::ConfigNode* options, std::initializer_list<KeyList> groups) {
-  if (options == nullptr) return;
-  std::vector<std::string> allowed;
-  for (const auto& group : groups) {
-    for (const auto key : group) {
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        allowed.emplace_back(key);
-      }
-    }
-  }
-  options->expect_keys(allowed);
+template <class O>
+std::vector<Option<O>> supply_settle_options() {
+  return {number_option<O>("supply_settle_seconds", 0.0, 3600.0,
+                           "after a supply step: no judging while the reference re-anchors [s]",
+                           [](O& o) -> double& { return o.supply_settle_seconds; })};
 }
 
 // The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
-// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; VG 46 when
-// neither is given.
-sim::Oil oil_of(const config::ConfigNode& options) {
+// two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; the rig's oil
+// (VG 46 unless its description says otherwise) when neither is given.
+sim::Oil oil_of(const config::ConfigNode& options, const sim::Oil& rig_oil) {
   const auto grade = options.find("oil_grade");
   const auto nu40 = options.find("oil_viscosity_40");
   const auto nu100 = options.find("oil_viscosity_100");
@@ -115,109 +91,339 @@ sim::Oil oil_of(const config::ConfigNode& options) {
     if (!(a > b)) nu100->fail("oil_viscosity_100 must be below oil_viscosity_40");
     return sim::Oil(a, b);
   }
-  return sim::Oil::standard();
+  return rig_oil;
 }
 
-IndexCusumOptions index_options(const config::ConfigNode* options, const AvailableSignals& s,
-                                double false_alarm_share) {
-  IndexCusumOptions o;
-  read_learning(options, o.learning);
-  read(options, "design_drop", o.design_drop, 0.005, 0.9);
-  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
-  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
-  read(options, "supply_pressure", o.rig.ps, 1e5, 1e9);
-  read(options, "tank_pressure", o.rig.pt, 0.0, 1e8);
-  read(options, "min_drop", o.min_drop, 0.0, 0.5);
-  read(options, "temperature_prior", o.temperature_prior, -2.0, 2.0);
-  read(options, "temperature_prior_sigma", o.temperature_prior_sigma, 1e-4, 10.0);
-  read(options, "drift_guard_seconds", o.drift_guard_seconds, 0.0, 3600.0);
-  read(options, "drift_window_seconds", o.drift_window_seconds, 0.0, 3600.0);
-  read(options, "supply_settle_seconds", o.supply_settle_seconds, 0.0, 3600.0);
-  if (options != nullptr) {
-    o.oil = oil_of(*options);
-    if (o.min_drop >= o.design_drop) {
-      const auto at = options->find("min_drop");
-      (at ? *at : options->at("design_drop")).fail("min_drop must be below design_drop");
-    }
+template <class O>
+std::vector<Option<O>> oil_options() {
+  return {other_option<O>("oil_grade", "46", "32, 46, 68",
+                          "ISO VG grade of the oil (the viscosity ratio with a `temp` channel)",
+                          [](O& o, const config::ConfigNode* node, const Option<O>&) {
+                            if (node != nullptr) o.oil = oil_of(*node, o.oil);
+                          }),
+          other_option<O>("oil_viscosity_40", "-", "1 to 10000",
+                          "instead of oil_grade: the data sheet's viscosity at 40 degC [mm^2/s]",
+                          nullptr),
+          other_option<O>("oil_viscosity_100", "-", "0.5 to 1000",
+                          "with oil_viscosity_40: the viscosity at 100 degC [mm^2/s]", nullptr)};
+}
+
+// The options' starting point on the actuator's rig: its supply, tank, command full scale,
+// valve, piston area and oil, which the options restating them override (rig_options.hpp).
+template <class O>
+O on_rig(O options, const sim::RigDescription& rig) {
+  if constexpr (requires { options.rig; }) options.rig = rig.params;
+  if constexpr (requires { options.oil; }) options.oil = rig.oil;
+  return options;
+}
+
+// Reads the rows, then the checks across options that only a configured mapping can fail.
+template <class O>
+O read_checked(const std::vector<Option<O>>& rows, O options, const config::ConfigNode* node,
+               void (*check)(const O&, const config::ConfigNode&)) {
+  read_options(rows, options, node);
+  if (node != nullptr && check != nullptr) check(options, *node);
+  return options;
+}
+
+// ---- paper ----
+
+std::vector<Option<PaperBaselineOptions>> paper_rows() {
+  using O = PaperBaselineOptions;
+  return learning_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("baseline_quantile", 0.0, 1.0,
+                              "the learned baseline is this quantile of the healthy index",
+                              [](O& o) -> double& { return o.baseline_quantile; }),
+             number_option<O>("window_seconds", 0.01, kMaxOptionSeconds,
+                              "judging window: the score is the share of its hops below [s]",
+                              [](O& o) -> double& { return o.window_seconds; }),
+             number_option<O>("raise_fraction", 0.0, 1.0, "raise threshold on that share",
+                              [](O& o) -> double& { return o.raise_fraction; }),
+             number_option<O>("clear_fraction", 0.0, 1.0,
+                              "clear threshold on that share (below raise_fraction)",
+                              [](O& o) -> double& { return o.clear_fraction; }),
+             other_option<O>("channel", "p1 if acquired, else p2", "p1, p2", "the index judged",
+                             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                               if (node == nullptr) return;
+                               o.use_p2 = node->get_choice(row.key, {"p1", "p2"},
+                                                           o.use_p2 ? "p2" : "p1") == "p2";
+                             })};
+}
+
+void check_paper(const PaperBaselineOptions& o, const config::ConfigNode& node) {
+  if (o.clear_fraction >= o.raise_fraction) {
+    node.at("clear_fraction").fail("clear_fraction must be below raise_fraction");
   }
+}
+
+PaperBaselineOptions paper_options(const config::ConfigNode* node, const AvailableSignals& s,
+                                   const sim::RigDescription&) {
+  PaperBaselineOptions o;
+  o.use_p2 = !s.p1;
+  return read_checked(paper_rows(), o, node, check_paper);
+}
+
+// ---- index_cusum ----
+
+std::vector<Option<IndexCusumOptions>> index_rows() {
+  using O = IndexCusumOptions;
+  return learning_options<O>() +
+         std::vector<Option<O>>{number_option<O>("design_drop", 0.005, 0.9,
+                                                 "relative index drop the CUSUM is tuned for",
+                                                 [](O& o) -> double& { return o.design_drop; })} +
+         false_alarm_options<O>() + supply_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("min_drop", 0.0, 0.5,
+                              "relative drop that is never an alarm (below design_drop)",
+                              [](O& o) -> double& { return o.min_drop; }),
+             number_option<O>("temperature_prior", -2.0, 2.0,
+                              "-d ln(index) / d ln(friction factor) assumed as far as learning "
+                              "saw too little temperature range",
+                              [](O& o) -> double& { return o.temperature_prior; }),
+             number_option<O>("temperature_prior_sigma", 1e-4, 10.0,
+                              "uncertainty of temperature_prior",
+                              [](O& o) -> double& { return o.temperature_prior_sigma; })} +
+         drift_options<O>(0.0) + supply_settle_options<O>() + oil_options<O>();
+}
+
+void check_index(const IndexCusumOptions& o, const config::ConfigNode& node) {
+  if (o.min_drop >= o.design_drop) {
+    const auto at = node.find("min_drop");
+    (at ? *at : node.at("design_drop")).fail("min_drop must be below design_drop");
+  }
+}
+
+IndexCusumOptions index_options(const config::ConfigNode* node, const AvailableSignals& s,
+                                double false_alarm_share, const sim::RigDescription& rig) {
+  IndexCusumOptions o =
+      read_checked(index_rows(), on_rig(IndexCusumOptions{}, rig), node, check_index);
   o.false_alarms_per_hour *= false_alarm_share;
   o.use_p1 = s.p1;
   o.use_p2 = s.p2;
   return o;
 }
 
-FlowBalanceOptions flow_options(const config::ConfigNode* options, double false_alarm_share) {
-  FlowBalanceOptions o;
-  read_learning(options, o.learning);
-  read(options, "supply_pressure", o.rig.ps, 1e5, 1e9);
-  read(options, "tank_pressure", o.rig.pt, 0.0, 1e8);
-  read(options, "command_full_scale", o.rig.u_max, 1e-3, 1e3);
-  read(options, "valve_coefficient", o.rig.Kv, 1e-12, 1.0);
-  read(options, "valve_coefficient_uncertainty", o.valve_coefficient_uncertainty, 0.0, 1.0);
-  double piston_area = o.rig.A();
-  read(options, "piston_area", piston_area, 1e-8, 10.0);
-  set_piston_area(o.rig, piston_area);
-  read(options, "rest_speed", o.rest_speed, 1e-6, 10.0);
-  read(options, "design_leak", o.design_leak, 1e-16, 1e-8);
-  read(options, "false_alarms_per_hour", o.false_alarms_per_hour, 1e-6, 100.0);
-  read(options, "block_seconds", o.block_seconds, 0.01, 60.0);
-  read(options, "sizing_seconds", o.sizing_seconds, 1.0, kMaxSeconds);
-  read(options, "min_leak", o.min_leak, 0.0, 1e-8);
-  read(options, "drift_guard_seconds", o.drift_guard_seconds, 0.0, 3600.0);
-  read(options, "drift_window_seconds", o.drift_window_seconds, 1.0, 3600.0);
-  if (options != nullptr) {
-    o.estimate_supply = options->get_bool("estimate_supply", o.estimate_supply);
-    o.oil = oil_of(*options);
-  }
+// ---- flow_balance ----
+
+// The rig table holds bore and rod (A = pi/4 (D^2 - d^2)); a configured piston_area keeps the
+// rod and sets the bore that gives that area.
+void set_piston_area(sim::Parameters& rig, double area) {
+  rig.D = std::sqrt(4.0 * area / std::numbers::pi + rig.d * rig.d);
+}
+
+std::vector<Option<FlowBalanceOptions>> flow_rows() {
+  using O = FlowBalanceOptions;
+  return learning_options<O>() + supply_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("command_full_scale", 1e-3, 1e3, "valve command full scale [V]",
+                              [](O& o) -> double& { return o.rig.u_max; }),
+             // A leak of interest is a share of the valve's flow (the test works in command
+             // units, MODEL.md "Other rigs"): design_leak's and min_leak's defaults are the
+             // paper's valve's, scaled to this one (their rows below take a configured value as
+             // it is).
+             other_option<O>(
+                 "valve_coefficient", "", "",
+                 "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]; design_leak's and min_leak's "
+                 "defaults scale with it",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr)
+                     o.rig.Kv = node->get_double(row.key, o.rig.Kv, row.lo, row.hi);
+                   const double valve_share = o.rig.Kv / sim::Parameters::nominal().Kv;
+                   o.design_leak = O{}.design_leak * valve_share;
+                   o.min_leak = O{}.min_leak * valve_share;
+                 },
+                 1e-12, 1.0, [](O& o) { return option_number_text(o.rig.Kv); }),
+             number_option<O>("valve_coefficient_uncertainty", 0.0, 1.0,
+                              "relative uncertainty of Kv (in the leak size's interval)",
+                              [](O& o) -> double& { return o.valve_coefficient_uncertainty; }),
+             // Always set (also when not configured): the bore is recomputed from the area.
+             other_option<O>(
+                 "piston_area", "", "", "piston area [m^2]; the default is the rig table's",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   double area = o.rig.A();
+                   if (node != nullptr) {
+                     area = node->get_double(row.key, area, row.lo, row.hi);
+                   }
+                   set_piston_area(o.rig, area);
+                 },
+                 1e-8, 10.0, [](O& o) { return option_number_text(o.rig.A()); }),
+             number_option<O>("rest_speed", 1e-6, 10.0,
+                              "a hop is at rest below this speed, as are its neighbours [m/s]",
+                              [](O& o) -> double& { return o.rest_speed; }),
+             number_option<O>("design_leak", 1e-16, 1e-8,
+                              "leak coefficient C_L the CUSUM is tuned for [m^3/(s Pa)]",
+                              [](O& o) -> double& { return o.design_leak; })} +
+         false_alarm_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("sizing_seconds", 1.0, kMaxOptionSeconds,
+                              "memory of the leak size estimate without a change [s]",
+                              [](O& o) -> double& { return o.sizing_seconds; }),
+             number_option<O>("min_leak", 0.0, 1e-8,
+                              "leak at 40 degC that is never an alarm [m^3/(s Pa)]",
+                              [](O& o) -> double& { return o.min_leak; })} +
+         drift_options<O>(1.0) +
+         std::vector<Option<O>>{other_option<O>(
+             "estimate_supply", "", "true, false",
+             "without `ps`: the supply from the chambers at rest",
+             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+               if (node != nullptr) {
+                 o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
+               }
+             },
+             0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
+         oil_options<O>();
+}
+
+FlowBalanceOptions flow_options(const config::ConfigNode* node, double false_alarm_share,
+                                const sim::RigDescription& rig) {
+  FlowBalanceOptions o = read_checked<FlowBalanceOptions>(
+      flow_rows(), on_rig(FlowBalanceOptions{}, rig), node, nullptr);
   o.false_alarms_per_hour *= false_alarm_share;
   return o;
 }
 
-PaperBaselineOptions paper_options(const config::ConfigNode* options, const AvailableSignals& s) {
-  PaperBaselineOptions o;
-  read_learning(options, o.learning);
-  read(options, "baseline_quantile", o.baseline_quantile, 0.0, 1.0);
-  read(options, "window_seconds", o.window_seconds, 0.01, kMaxSeconds);
-  read(options, "raise_fraction", o.raise_fraction, 0.0, 1.0);
-  read(options, "clear_fraction", o.clear_fraction, 0.0, 1.0);
-  o.use_p2 = !s.p1;
-  if (options != nullptr) {
-    o.use_p2 = options->get_choice("channel", {"p1", "p2"}, s.p1 ? "p1" : "p2") == "p2";
-    if (o.clear_fraction >= o.raise_fraction) {
-      options->at("clear_fraction").fail("clear_fraction must be below raise_fraction");
-    }
-  }
-  return o;
-}
+// ---- detail_xcorr ----
 
 // design_shift / min_shift are in the feature's units: correlation with both chambers, ln of
 // the band ratio with one (detail_xcorr_detector.hpp).
-DetailXcorrOptions xcorr_options(const config::ConfigNode* options, const AvailableSignals& s) {
-  DetailXcorrOptions o;
-  o.test = index_options(options, s, 1.0);
-  // Two windows per block: the sliding feature's neighbouring blocks then share little data.
-  o.test.block_seconds = kXcorrBlockSeconds;
-  read(options, "block_seconds", o.test.block_seconds, 0.01, 60.0);
-  const bool correlation = s.p1 && s.p2;
-  double& design = correlation ? o.design_shift_correlation : o.design_shift_ratio;
-  double& floor = correlation ? o.min_shift_correlation : o.min_shift_ratio;
-  read(options, "design_shift", design, 1e-5, 2.0);
-  read(options, "min_shift", floor, 0.0, 2.0);
-  if (options != nullptr && floor >= design) {
-    const auto at = options->find("min_shift");
-    (at ? *at : options->at("design_shift")).fail("min_shift must be below design_shift");
-  }
-  return o;
+bool correlation(const DetailXcorrOptions& o) { return o.use_p1 && o.use_p2; }
+
+std::vector<Option<DetailXcorrOptions>> xcorr_rows() {
+  using O = DetailXcorrOptions;
+  return learning_options<O>() +
+         std::vector<Option<O>>{
+             other_option<O>(
+                 "design_shift", "", "",
+                 "shift of the feature the CUSUM is tuned for: correlation with both chambers, ln "
+                 "band ratio with one",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   double& design =
+                       correlation(o) ? o.design_shift_correlation : o.design_shift_ratio;
+                   if (node != nullptr) {
+                     design = node->get_double(row.key, design, row.lo, row.hi);
+                   }
+                 },
+                 1e-5, 2.0,
+                 [](O& o) {
+                   return option_number_text(o.design_shift_correlation) + " (correlation) or " +
+                          option_number_text(o.design_shift_ratio) + " (ln band ratio)";
+                 }),
+             other_option<O>(
+                 "min_shift", "", "", "shift that is never an alarm (below design_shift)",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   double& floor = correlation(o) ? o.min_shift_correlation : o.min_shift_ratio;
+                   if (node != nullptr) {
+                     floor = node->get_double(row.key, floor, row.lo, row.hi);
+                   }
+                 },
+                 0.0, 2.0,
+                 [](O& o) {
+                   return option_number_text(o.min_shift_correlation) + " (correlation) or " +
+                          option_number_text(o.min_shift_ratio) + " (ln band ratio)";
+                 })} +
+         false_alarm_options<O>() + supply_options<O>() + drift_options<O>(0.0) +
+         supply_settle_options<O>();
 }
 
-void require(bool ok, const std::string& kind, const char* what) {
-  if (!ok) throw std::invalid_argument("detector '" + kind + "' needs " + what);
+void check_xcorr(const DetailXcorrOptions& o, const config::ConfigNode& node) {
+  const bool both = correlation(o);
+  const double design = both ? o.design_shift_correlation : o.design_shift_ratio;
+  const double floor = both ? o.min_shift_correlation : o.min_shift_ratio;
+  if (floor >= design) {
+    const auto at = node.find("min_shift");
+    (at ? *at : node.at("design_shift")).fail("min_shift must be below design_shift");
+  }
+}
+
+DetailXcorrOptions xcorr_options(const config::ConfigNode* node, const AvailableSignals& s,
+                                 const sim::RigDescription& rig) {
+  DetailXcorrOptions o = on_rig(DetailXcorrOptions{}, rig);
+  o.use_p1 = s.p1;
+  o.use_p2 = s.p2;
+  return read_checked(xcorr_rows(), o, node, check_xcorr);
+}
+
+// ---- the registry ----
+
+bool has_pressure(const AvailableSignals& s) { return s.p1 || s.p2; }
+bool has_all(const AvailableSignals& s) { return s.p1 && s.p2 && s.u && s.x; }
+
+// Union of the keys, first occurrence kept.
+std::vector<std::string> merged(std::vector<std::string> a, const std::vector<std::string>& b) {
+  for (const auto& key : b) {
+    if (std::find(a.begin(), a.end(), key) == a.end()) a.push_back(key);
+  }
+  return a;
+}
+
+std::vector<std::string> fused_keys() {
+  return merged(option_keys(index_rows()), option_keys(flow_rows()));
+}
+
+// A kind that is one detector: its options read through its table by Read, then built.
+template <class D, class O, std::vector<Option<O>> (*Rows)(),
+          O (*Read)(const config::ConfigNode*, const AvailableSignals&, const sim::RigDescription&)>
+DetectorKind single_kind(std::string_view name, std::string_view needs,
+                         bool (*runs_on)(const AvailableSignals&)) {
+  return {name,
+          needs,
+          runs_on,
+          [] { return option_keys(Rows()); },
+          [](const AvailableSignals& s, double hop, const config::ConfigNode* node,
+             const sim::RigDescription& rig) -> std::unique_ptr<Detector> {
+            return std::make_unique<D>(Read(node, s, rig), hop);
+          },
+          [] { return options_markdown(Rows()); }};
+}
+
+IndexCusumOptions index_alone(const config::ConfigNode* node, const AvailableSignals& s,
+                              const sim::RigDescription& rig) {
+  return index_options(node, s, 1.0, rig);
+}
+FlowBalanceOptions flow_alone(const config::ConfigNode* node, const AvailableSignals&,
+                              const sim::RigDescription& rig) {
+  return flow_options(node, 1.0, rig);
 }
 
 }  // namespace
 
+std::vector<DetectorKind> detector_registry() {
+  constexpr std::string_view kPressure = "a chamber pressure (p1 or p2)", kAll = "p1, p2, u and x";
+  return {
+      single_kind<PaperBaselineDetector, PaperBaselineOptions, paper_rows, paper_options>(
+          "paper", kPressure, has_pressure),
+      single_kind<IndexCusumDetector, IndexCusumOptions, index_rows, index_alone>(
+          "index_cusum", kPressure, has_pressure),
+      single_kind<FlowBalanceDetector, FlowBalanceOptions, flow_rows, flow_alone>("flow_balance",
+                                                                                  kAll, has_all),
+      {"fused", kAll, has_all, fused_keys,
+       [](const AvailableSignals& s, double hop, const config::ConfigNode* node,
+          const sim::RigDescription& rig) -> std::unique_ptr<Detector> {
+         std::vector<std::unique_ptr<Detector>> members;
+         // Flow balance first: it is the one that sizes the leak. Each member gets half the
+         // false-alarm budget, so the union keeps the target rate.
+         members.push_back(
+             std::make_unique<FlowBalanceDetector>(flow_options(node, 0.5, rig), hop));
+         members.push_back(
+             std::make_unique<IndexCusumDetector>(index_options(node, s, 0.5, rig), hop));
+         return std::make_unique<FusedDetector>(std::move(members));
+       },
+       [] {
+         return std::string(
+             "The keys of `flow_balance` and `index_cusum`; each member reads those it has (a "
+             "key both have, such as `block_seconds`, goes to both), and each gets half of "
+             "`false_alarms_per_hour`.\n");
+       }},
+      single_kind<DetailXcorrDetector, DetailXcorrOptions, xcorr_rows, xcorr_options>(
+          "detail_xcorr", kPressure, has_pressure),
+  };
+}
+
 std::vector<std::string> detector_kinds() {
-  return {"default", "paper", "index_cusum", "flow_balance", "fused", "detail_xcorr"};
+  std::vector<std::string> kinds = {"default"};
+  for (const auto& kind : detector_registry()) kinds.emplace_back(kind.name);
+  return kinds;
 }
 
 // Chosen by `leakmon evaluate` (docs/detection.md): with u and x the flow balance alone detects
@@ -232,43 +438,31 @@ std::string default_detector_kind(const AvailableSignals& signals) {
 }
 
 std::unique_ptr<Detector> make_detector(const std::string& kind, const AvailableSignals& signals,
-                                        double hop_seconds, const config::ConfigNode* options) {
+                                        double hop_seconds, const config::ConfigNode* options,
+                                        const sim::RigDescription* rig) {
   if (!(hop_seconds > 0.0)) throw std::invalid_argument("detector hop must be positive");
+  const sim::RigDescription base = rig != nullptr ? *rig : sim::RigDescription::paper();
   const std::string resolved = kind == "default" ? default_detector_kind(signals) : kind;
-  if (resolved == "paper") {
-    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
-    expect_keys(options, {kLearningKeys, kPaperKeys});
-    return std::make_unique<PaperBaselineDetector>(paper_options(options, signals), hop_seconds);
-  }
-  if (resolved == "index_cusum") {
-    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
-    expect_keys(options, {kLearningKeys, kIndexKeys});
-    return std::make_unique<IndexCusumDetector>(index_options(options, signals, 1.0), hop_seconds);
-  }
-  if (resolved == "detail_xcorr") {
-    require(has_pressure(signals), kind, "a chamber pressure (p1 or p2)");
-    expect_keys(options, {kLearningKeys, kXcorrKeys});
-    return std::make_unique<DetailXcorrDetector>(xcorr_options(options, signals), hop_seconds);
-  }
-  if (resolved == "flow_balance") {
-    require(has_all(signals), kind, "p1, p2, u and x");
-    expect_keys(options, {kLearningKeys, kFlowKeys});
-    return std::make_unique<FlowBalanceDetector>(flow_options(options, 1.0), hop_seconds);
-  }
-  if (resolved == "fused") {
-    require(has_all(signals), kind, "p1, p2, u and x");
-    expect_keys(options, {kLearningKeys, kIndexKeys, kFlowKeys});
-    std::vector<std::unique_ptr<Detector>> members;
-    // Flow balance first: it is the one that sizes the leak.
-    members.push_back(
-        std::make_unique<FlowBalanceDetector>(flow_options(options, 0.5), hop_seconds));
-    members.push_back(
-        std::make_unique<IndexCusumDetector>(index_options(options, signals, 0.5), hop_seconds));
-    return std::make_unique<FusedDetector>(std::move(members));
+  for (const auto& entry : detector_registry()) {
+    if (entry.name != resolved) continue;
+    if (!entry.runs_on(signals)) {
+      throw std::invalid_argument("detector '" + kind + "' needs " + std::string(entry.needs));
+    }
+    if (options != nullptr) options->expect_keys(entry.option_keys());
+    return entry.build(signals, hop_seconds, options, base);
   }
   std::string known;
   for (const auto& k : detector_kinds()) known += (known.empty() ? "" : ", ") + k;
   throw std::invalid_argument("unknown detector kind '" + kind + "' (known: " + known + ")");
+}
+
+std::string detector_options_reference() {
+  std::string out;
+  for (const auto& kind : detector_registry()) {
+    out += "`" + std::string(kind.name) + "` (needs " + std::string(kind.needs) + "):\n\n";
+    out += kind.options_reference() + "\n";
+  }
+  return out;
 }
 
 }  // namespace leakmon::detect

@@ -25,13 +25,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <string_view>
 #include <vector>
 
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
+#include "detect/drift_reference.hpp"
 #include "detect/learning_schedule.hpp"
+#include "detect/supply_tracker.hpp"
 #include "detect/valve_flow.hpp"
 #include "sim/oil.hpp"
 #include "sim/parameters.hpp"
@@ -47,8 +50,10 @@ struct FlowBalanceOptions {
   double valve_coefficient_uncertainty = 0.1;  // relative
   // A hop is at rest when |dx/dt| stays below rest_speed over it and both its neighbours: a hop
   // that holds the first or last few samples of a move carries flows the balance does not model.
-  double rest_speed = 2e-3;      // [m/s]
-  double design_leak = 2.5e-13;  // C_L the CUSUM is tuned for [m^3/(s Pa)]
+  double rest_speed = 2e-3;  // [m/s]
+  // C_L the CUSUM is tuned for [m^3/(s Pa)]; the factory scales this default and min_leak's by
+  // the valve's Kv over the paper's 3.39e-7 (a leak of interest is a share of the valve's flow).
+  double design_leak = 2.5e-13;
   double false_alarms_per_hour = 0.05;
   double block_seconds = 0.8;
   double min_rest_fraction = 0.25;  // a block needs this share of hops at rest
@@ -82,6 +87,9 @@ class FlowBalanceDetector final : public Detector {
   }
   void resume_after_gap() override;
 
+  // The layout export_state() writes (legacy_state.hpp reads the ones before).
+  static constexpr int kStateVersion = 3;
+
  private:
   struct Hop {
     double t = kMissing;
@@ -95,10 +103,27 @@ class FlowBalanceDetector final : public Detector {
     double viscosity_ratio = kMissing;  // nu(40) / nu(T) with a temperature
     bool usable = false;  // all signals present and the command within the valve's range
   };
-  struct RestHop {
-    Hop hop;
-    std::size_t block;  // block number, to regroup the learning data
+  struct RestHop : Hop {
+    std::size_t block = 0;  // block number, to regroup the learning data
   };
+  // The state's names of a hop's fields (a learned rest hop's: also its block).
+  template <class Record>
+  static constexpr std::array<RecordField<Record>, 9> hop_fields() {
+    return {record_field<&Hop::t, Record>("t"),
+            record_field<&Hop::opening, Record>("opening"),
+            record_field<&Hop::load, Record>("load"),
+            record_field<&Hop::root, Record>("root"),
+            record_field<&Hop::leak_term, Record>("leak_term"),
+            record_field<&Hop::speed, Record>("speed"),
+            record_field<&Hop::supply, Record>("supply"),
+            record_field<&Hop::viscosity_ratio, Record>("viscosity_ratio"),
+            record_field<&Hop::usable, Record>("usable")};
+  }
+  static constexpr std::array<RecordField<RestHop>, 10> rest_hop_fields() {
+    const auto hop = hop_fields<RestHop>();
+    return {hop[0], hop[1], hop[2], hop[3], hop[4],
+            hop[5], hop[6], hop[7], hop[8], record_field<&RestHop::block>("block")};
+  }
   static constexpr int kTerms = 6;
   using Terms = Eigen::Matrix<double, kTerms, 1>;
   Terms healthy_terms(const Hop& hop) const;
@@ -118,28 +143,22 @@ class FlowBalanceDetector final : public Detector {
   void finish_learning();
   void judge_block(double t, double mean_residual, double mean_leak_term);
   double supply_for(const Observation& o, double speed);
-  // Drift following: the healthy slope extrapolated to t from the reference window's blocks.
-  struct TrendBlock {
-    double t, residual, leak_term;
-  };
-  void remember_block(double t, double residual, double leak_term);
-  double drift_slope(double t) const;
+  // Drift following (the healthy slope as a reference) only without a temperature.
   bool follows_drift() const { return !temperature_seen_; }
 
   FlowBalanceOptions options_;
   double hop_seconds_;
-  std::size_t settle_hops_, learn_hops_, block_hops_, min_rest_hops_;
-  double piston_area_;   // A() of the rig table, computed once
-  double design_slope_;  // design_leak in the normalised units of the regression
-  double floor_slope_;   // min_leak in the same units
-  double sizing_decay_;  // per block
-  std::size_t observations_ = 0;
-  std::size_t hops_seen_ = 0;  // accepted hops (one behind the observations)
+  LearningClock clock_;
+  std::size_t block_hops_, min_rest_hops_;
+  double piston_area_;            // A() of the rig table, computed once
+  double design_slope_;           // design_leak in the normalised units of the regression
+  double floor_slope_;            // min_leak in the same units
+  double sizing_decay_;           // per block
+  std::size_t observations_ = 0;  // the learning clock counts accepted hops, one behind
   double previous_x_ = kMissing;
   Hop before_, pending_;          // the two latest hops; pending_ is judged when the next arrives
   std::vector<RestHop> learned_;  // reserved at construction
   std::vector<double> scratch_;   // reserved at construction
-  bool learned_model_ = false;
   LoadRange positive_loads_, negative_loads_;
   Terms coefficients_ = Terms::Zero();
   double hop_sigma_ = kMissing;  // robust spread of one hop's residual
@@ -156,15 +175,12 @@ class FlowBalanceDetector final : public Detector {
   // The block in which the CUSUM left zero holds the change itself, so it is partly healthy
   // data: it sizes the leak only until a later block arrives.
   SlopeSums weighted_, since_change_, change_block_;
-  Cusum cusum_;
+  BlockCusum cusum_;
   Decision last_;
-  // Supply tracking (no `ps` observation): rest-sum estimate and its settling state.
-  double supply_estimate_ = kMissing;
-  double supply_settled_since_ = kMissing;  // t at which the last supply transient ended
+  SupplyTracker supply_;  // from `ps`, or the chambers at rest (rule: jump)
   bool temperature_seen_ = false;
-  // Blocks for the drift trend, oldest first in a ring (capacity reserved at construction).
-  std::vector<TrendBlock> trend_;
-  std::size_t trend_next_ = 0, trend_count_ = 0;
+  // The healthy slope on the leak term, followed without a temperature.
+  DriftReference drift_;
 };
 
 }  // namespace leakmon::detect

@@ -3,8 +3,12 @@
 // while learning becomes part of the baseline; reset() after maintenance starts over.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <string_view>
+
+#include "detect/detector_state.hpp"
 
 namespace leakmon::detect {
 
@@ -18,6 +22,54 @@ struct LearningSchedule {
   std::size_t learn_hops(double hop_seconds) const {
     return static_cast<std::size_t>(std::lround(learn_seconds / hop_seconds));
   }
+};
+
+// `seconds` in whole hops, at least one (a block, a judging window).
+inline std::size_t hops_in(double seconds, double hop_seconds) {
+  return std::max<std::size_t>(static_cast<std::size_t>(std::lround(seconds / hop_seconds)), 1);
+}
+
+// Where a detector stands in its schedule, counted in hops: the preamble every detector
+// shares. Per hop: count_hop() (false while settling: ignore the hop), hops_left() for the
+// decision while not learned(), and at period_over() the detector learns and calls
+// set_learned() (a detector that still lacks data may learn later).
+class LearningClock {
+ public:
+  LearningClock(const LearningSchedule& schedule, double hop_seconds)
+      : settle_hops_(schedule.settle_hops(hop_seconds)),
+        learn_hops_(std::max<std::size_t>(schedule.learn_hops(hop_seconds), 1)) {}
+
+  std::size_t settle_hops() const { return settle_hops_; }
+  std::size_t learn_hops() const { return learn_hops_; }
+
+  // Counts this hop; false while it falls in the settling time.
+  bool count_hop() { return ++hops_seen_ > settle_hops_; }
+  // Hops until learned (settling included; 0 once the learning period is over), for
+  // Decision::learning_hops_left.
+  double hops_left() const {
+    const std::size_t total = settle_hops_ + learn_hops_;
+    return static_cast<double>(hops_seen_ >= total ? 0 : total - hops_seen_);
+  }
+  // The hop just counted, from 0 at the first hop of the learning period (after settling).
+  std::size_t learning_hop() const { return hops_seen_ - settle_hops_ - 1; }
+  // The learning period ended with the hop just counted, or before it.
+  bool period_over() const { return hops_seen_ - settle_hops_ >= learn_hops_; }
+
+  bool learned() const { return learned_; }
+  void set_learned() { learned_ = true; }
+  void reset() {
+    hops_seen_ = 0;
+    learned_ = false;
+  }
+
+  // `prefix.hops_seen` and `prefix.learned`.
+  void save(DetectorState& state, std::string_view prefix) const;
+  void restore(const DetectorState& state, std::string_view prefix);
+
+ private:
+  std::size_t settle_hops_, learn_hops_;
+  std::size_t hops_seen_ = 0;
+  bool learned_ = false;
 };
 
 // Target false-alarm rate -> the threshold of a log-likelihood-ratio CUSUM that judges one

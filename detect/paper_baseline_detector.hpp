@@ -4,12 +4,14 @@
 // `window_seconds` of hops under it. Kept as the reference point the other detectors must beat.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <string_view>
 #include <vector>
 
 #include "detect/detector.hpp"
 #include "detect/learning_schedule.hpp"
+#include "detect/ring.hpp"
 
 namespace leakmon::detect {
 
@@ -38,14 +40,22 @@ class PaperBaselineDetector final : public Detector {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
   }
 
+  // The layout export_state() writes (legacy_state.hpp reads the ones before).
+  static constexpr int kStateVersion = 2;
+
  private:
+  struct Verdict {
+    bool below = false;  // the hop's index was below the baseline
+  };
+  static constexpr std::array<RecordField<Verdict>, 1> kVerdictFields = {
+      record_field<&Verdict::below>("below")};
+
   PaperBaselineOptions options_;
-  std::size_t settle_hops_, learn_hops_;
-  std::size_t hops_seen_ = 0;
+  LearningClock clock_;
   std::vector<double> learned_;  // healthy indices, reserved at construction
   double baseline_ = kMissing;
-  std::vector<unsigned char> below_;  // ring of the last window's verdicts (1 below, 0 above)
-  std::size_t ring_next_ = 0, ring_filled_ = 0, below_count_ = 0;
+  Ring<Verdict> window_;  // the last window's verdicts
+  std::size_t below_count_ = 0;
 };
 
 }  // namespace leakmon::detect

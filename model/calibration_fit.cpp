@@ -12,12 +12,29 @@ namespace {
 // 1 + (value - initial) / scale, so that every unknown starts near 1 and a unit step in any
 // of them is a comparable change of the model.
 constexpr int kCalibrationCount = 4;  // beta, Kv, m, b
+// On the paper's rig; on another rig each scale follows its stated value (Scales below).
 constexpr double kScales[kCalibrationCount] = {1e8, 1e-7, 1.0, 100.0};
 // Bounds in solver units: twice MODEL.md's calibratable ranges (beta +-25 %, Kv +-10 %,
-// m +-20 %, b +-30 %), so that a discrepancy cannot be absorbed by an absurd calibration
-// (a 50 kg piston, say) instead of showing as an effect.
+// m +-20 %, b +-30 %) around the stated value, so that a discrepancy cannot be absorbed by an
+// absurd calibration (a 50 kg piston, say) instead of showing as an effect.
 constexpr double kLower[kCalibrationCount] = {3.5, 2.712, 6.0, 1.2};
 constexpr double kUpper[kCalibrationCount] = {10.5, 4.068, 14.0, 4.8};
+
+// The solver's scales for a rig whose stated calibratable values are `stated`: the paper's
+// scales times stated / the paper's value, so that the solver units and the bounds in them
+// mean the same relative ranges on every rig (on the paper's rig exactly the constants).
+struct Scales {
+  double value[kCalibrationCount];
+  explicit Scales(const Calibration& stated) {
+    const Calibration paper;
+    const double ratio[kCalibrationCount] = {stated.beta / paper.beta, stated.Kv / paper.Kv,
+                                             stated.m / paper.m, stated.b / paper.b};
+    for (int i = 0; i < kCalibrationCount; ++i) {
+      value[i] = ratio[i] == 1.0 ? kScales[i] : kScales[i] * ratio[i];
+    }
+  }
+  double operator[](int i) const { return value[i]; }
+};
 
 // An effect parameter beyond a bound is mirrored back into [lower, upper] rather than clamped:
 // a clamped parameter has no gradient, and a solver step that overshoots the bound (the first
@@ -35,7 +52,7 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   // Only the calibration parameters flagged in `free` are unknowns; the others stay at `start`.
   SegmentFitProblem(const SegmentPredictor& predictor, std::span<const Segment> segments,
                     const EffectCandidate* candidate, const Calibration& start,
-                    const CalibrationMask& free)
+                    const CalibrationMask& free, const Calibration& stated)
       : Eigen::DenseFunctor<double>(
             static_cast<int>(std::count(free.begin(), free.end(), true)) +
                 static_cast<int>(candidate ? candidate->parameters.size() : 0),
@@ -43,7 +60,8 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
         predictor_(predictor),
         segments_(segments),
         candidate_(candidate),
-        start_(start) {
+        start_(start),
+        scales_(stated) {
     for (int i = 0; i < kCalibrationCount; ++i) {
       if (free[static_cast<std::size_t>(i)]) calibration_slot_[i] = first_effect_++;
     }
@@ -56,7 +74,7 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
     InputType theta = InputType::Ones(inputs());
     const double start[kCalibrationCount] = {start_.beta, start_.Kv, start_.m, start_.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
-      if (calibration_slot_[i] >= 0) theta[calibration_slot_[i]] = start[i] / kScales[i];
+      if (calibration_slot_[i] >= 0) theta[calibration_slot_[i]] = start[i] / scales_[i];
     }
     return theta;
   }
@@ -68,9 +86,9 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
                                          &p.calibration.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       if (calibration_slot_[i] < 0) continue;
-      *values[i] = std::clamp(theta[calibration_slot_[i]], kLower[i], kUpper[i]) * kScales[i];
+      *values[i] = std::clamp(theta[calibration_slot_[i]], kLower[i], kUpper[i]) * scales_[i];
     }
-    if (candidate_) candidate_->apply(p.effects, effect_values(theta));
+    if (candidate_) candidate_->apply(p, effect_values(theta));
     return p;
   }
 
@@ -110,12 +128,14 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   }
 
   int evaluations() const { return evaluations_; }
+  double scale(int i) const { return scales_[i]; }
 
  private:
   const SegmentPredictor& predictor_;
   std::span<const Segment> segments_;
   const EffectCandidate* candidate_;
   Calibration start_;
+  Scales scales_;
   int calibration_slot_[kCalibrationCount] = {-1, -1, -1, -1};
   int first_effect_ = 0;
   mutable int evaluations_ = 0;
@@ -126,7 +146,8 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
 FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> segments,
                     const EffectCandidate* candidate, const Calibration& start,
                     const FitSettings& settings) {
-  SegmentFitProblem problem(predictor, segments, candidate, start, settings.free_calibration);
+  SegmentFitProblem problem(predictor, segments, candidate, start, settings.free_calibration,
+                            settings.stated);
   Eigen::VectorXd theta = problem.start_point();
   Eigen::LevenbergMarquardt<SegmentFitProblem> solver(problem);
   solver.setMaxfev(settings.max_iterations);
@@ -156,7 +177,7 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
         &result.calibration_errors.m, &result.calibration_errors.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       const int slot = problem.calibration_slot(i);
-      *errors[i] = slot >= 0 ? err(slot) * kScales[i] : 0.0;
+      *errors[i] = slot >= 0 ? err(slot) * problem.scale(i) : 0.0;
     }
     if (candidate) {
       for (std::size_t i = 0; i < candidate->parameters.size(); ++i) {
@@ -169,25 +190,34 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
   return result;
 }
 
-std::vector<std::string> calibration_at_bound(const Calibration& c, double tolerance) {
+std::vector<std::string> calibration_at_bound(const Calibration& c, const Calibration& stated,
+                                              double tolerance) {
+  const Scales scales(stated);
   const double values[kCalibrationCount] = {c.beta, c.Kv, c.m, c.b};
   const char* names[kCalibrationCount] = {"beta", "Kv", "m", "b"};
   std::vector<std::string> out;
   for (int i = 0; i < kCalibrationCount; ++i) {
-    const double v = values[i] / kScales[i];
+    const double v = values[i] / scales[i];
     const double margin = tolerance * (kUpper[i] - kLower[i]);
     if (v <= kLower[i] + margin || v >= kUpper[i] - margin) out.emplace_back(names[i]);
   }
   return out;
 }
 
-Calibration within_bounds(const Calibration& c) {
+Calibration within_bounds(const Calibration& c, const Calibration& stated) {
   // A tenth of the way in from a bound: the solver then has room in both directions.
-  const auto inside = [](double v, int i) {
+  const Scales scales(stated);
+  const auto inside = [&](double v, int i) {
     const double margin = 0.1 * (kUpper[i] - kLower[i]);
-    return std::clamp(v / kScales[i], kLower[i] + margin, kUpper[i] - margin) * kScales[i];
+    return std::clamp(v / scales[i], kLower[i] + margin, kUpper[i] - margin) * scales[i];
   };
   return {inside(c.beta, 0), inside(c.Kv, 1), inside(c.m, 2), inside(c.b, 3)};
+}
+
+std::pair<Calibration, Calibration> calibration_bounds(const Calibration& stated) {
+  const Scales s(stated);
+  return {{kLower[0] * s[0], kLower[1] * s[1], kLower[2] * s[2], kLower[3] * s[3]},
+          {kUpper[0] * s[0], kUpper[1] * s[1], kUpper[2] * s[2], kUpper[3] * s[3]}};
 }
 
 }  // namespace leakmon::model

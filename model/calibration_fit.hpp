@@ -6,6 +6,7 @@
 #include <array>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/effect_library.hpp"
@@ -19,6 +20,9 @@ struct FitSettings {
   int max_iterations = 15;     // solver steps (each with a Jacobian: one simulation per unknown)
   bool uncertainties = false;  // also compute standard errors (one more Jacobian)
   CalibrationMask free_calibration = {true, true, true, true};  // others stay at `start`
+  // The rig's stated beta, Kv, m, b: the solver's scales and the bounds (twice MODEL.md's
+  // calibratable ranges) are relative to them. The paper's rig unless a rig is described.
+  Calibration stated;
 };
 
 struct FitResult {
@@ -39,8 +43,12 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
 // The calibratable parameters (beta, Kv, m, b) that sit on the bound the fit holds them to
 // (within `tolerance` of the bound interval's width): such a value is not a calibration but a
 // sign that the model is compensating for something it lacks.
-std::vector<std::string> calibration_at_bound(const Calibration& c, double tolerance = 0.002);
-// `c` moved inside the bounds (a start for a retry).
-Calibration within_bounds(const Calibration& c);
+// `stated`: the rig's stated values the bounds are relative to.
+std::vector<std::string> calibration_at_bound(const Calibration& c, const Calibration& stated = {},
+                                              double tolerance = 0.002);
+// `c` moved inside the bounds around `stated` (a start for a retry).
+Calibration within_bounds(const Calibration& c, const Calibration& stated = {});
+// The fit's bounds around `stated`: lower and upper calibration.
+std::pair<Calibration, Calibration> calibration_bounds(const Calibration& stated = {});
 
 }  // namespace leakmon::model

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
+#include "model/change_point.hpp"
 #include "model/force_balance.hpp"
 #include "model/spectral_line.hpp"
 
@@ -110,8 +112,22 @@ std::vector<NamedValue> named_values(const EffectCandidate& c, const FitResult& 
 
 }  // namespace
 
+NamedCause rig_cause(const RigFinding& finding) {
+  return {"rig_parameter",
+          {{"parameter", 0.0, 0.0, finding.parameter},
+           {"stated", finding.stated, 0.0, ""},
+           {"fitted", finding.fitted, finding.error, ""}},
+          0.0};
+}
+
 Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settings) {
+  return diagnose(record, sim::RigDescription::paper(), settings);
+}
+
+Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
+                   const DiagnosisSettings& settings) {
   Diagnosis d;
+  d.rig = rig;
   d.plan = split_record(record, settings.split);
   if (d.plan.fitting.size() < 4 || d.plan.held_out.size() < 4) {
     throw ModelCheckError(fmt::format(
@@ -121,7 +137,44 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   }
   d.fitting_used = spread(d.plan.fitting, settings.max_fitting_segments);
   d.held_out_used = spread(d.plan.held_out, settings.max_held_out_segments);
-  const SegmentPredictor predictor(record);
+
+  // The stated values first: a contradicted one is corrected before any effect is judged, and
+  // named when the corrected rig's calibrated nominal model predicts the held-out data better.
+  d.rig_check = check_rig(record, d.plan.fitting, rig.params, settings.rig);
+  if (!d.rig_check.findings.empty()) {
+    // The calibrated nominal model on a rig: m from the force balance where usable.
+    const auto calibrated_nominal = [&](const sim::Parameters& on) {
+      const SegmentPredictor p(record, on);
+      FitSettings fs = settings.fit;
+      fs.stated = Calibration::of(on);
+      Calibration start = Calibration::of(on);
+      const ForceBalance fb = estimate_force_balance(record, d.plan.fitting, on);
+      if (settings.use_force_balance && usable(fb, on.m)) {
+        start.m = fb.m;
+        start.b = fb.b;
+        fs.free_calibration = {true, true, false, true};
+      }
+      const FitResult fit = fit_model(p, d.fitting_used, nullptr, start, fs);
+      return std::pair{segment_errors(p, fit.parameters, d.held_out_used),
+                       p.nrmse(fit.parameters, d.held_out_used)};
+    };
+    const auto [stated_errors, stated_nrmse] = calibrated_nominal(d.rig_check.stated);
+    const auto [corrected_errors, corrected_nrmse] = calibrated_nominal(d.rig_check.assumed);
+    d.nrmse_stated = stated_nrmse;
+    d.nrmse_corrected = corrected_nrmse;
+    d.rig_score = 1.0 - std::exp(-mean_log_ratio(stated_errors, corrected_errors));
+    d.rig_significance = std::max(paired_t(stated_errors, corrected_errors),
+                                  trimmed_t(stated_errors, corrected_errors));
+    if (d.rig_score < settings.min_score || d.rig_significance < settings.min_significance ||
+        corrected_nrmse >= stated_nrmse) {
+      d.rig_rejected = std::move(d.rig_check.findings);
+      d.rig_check.findings.clear();
+      d.rig_check.assumed = d.rig_check.stated;
+    }
+  }
+  const sim::Parameters& assumed = d.rig_check.assumed;
+  const Calibration stated_calibration = Calibration::of(assumed);
+  const SegmentPredictor predictor(record, assumed);
 
   // Only a line that passes its second-half test is worth a ripple candidate: without one the
   // ripple fit would merely chase the tallest noise peak.
@@ -129,15 +182,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   d.min_line_z = settings.min_line_z;
   d.ripple_line_significant = d.ripple_line && d.ripple_line->held_out_z >= settings.min_line_z;
   const auto library = effect_library(d.ripple_line_significant ? d.ripple_line->frequency_hz : 0.0,
-                                      !record.temp.empty(), record.dt);
+                                      !record.temp.empty(), record.dt, assumed);
 
   // m from the measured force balance, where it is usable: the simulation fit then calibrates
   // beta, Kv and b (from the force balance's b), and cannot slide along the beta/m/b valley.
   // b stays free: in the force balance it shares the moving windows with the friction term.
-  d.force_balance = estimate_force_balance(record, d.plan.fitting);
-  Calibration catalogue;  // MODEL.md's values, m and b measured when possible
+  d.force_balance = estimate_force_balance(record, d.plan.fitting, assumed);
+  Calibration catalogue = stated_calibration;  // the rig's values, m and b measured if possible
   FitSettings fit_settings = settings.fit;
-  if (settings.use_force_balance && usable(d.force_balance)) {
+  fit_settings.stated = stated_calibration;
+  if (settings.use_force_balance && usable(d.force_balance, assumed.m)) {
     catalogue.m = d.force_balance.m;
     catalogue.b = d.force_balance.b;
     fit_settings.free_calibration = {true, true, false, true};
@@ -169,7 +223,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // A calibration on its bounds is the model compensating for something it lacks (a strong
   // droop drove beta, Kv and b to their limits): retry from the calibrations that the best
   // screened effect candidates reached, moved inside the bounds.
-  d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration);
+  d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration, stated_calibration);
   if (!d.nominal_at_bound.empty()) {
     std::vector<const FitResult*> starts;
     for (const auto& fit : screened) starts.push_back(&fit);
@@ -177,21 +231,73 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
                      [](const FitResult* a, const FitResult* b) { return a->cost < b->cost; });
     starts.resize(std::min<std::size_t>(starts.size(), 3));
     for (const FitResult* start : starts) {
-      FitResult retry = fit_model(predictor, d.fitting_used, nullptr,
-                                  within_bounds(start->parameters.calibration), fit_settings);
+      FitResult retry =
+          fit_model(predictor, d.fitting_used, nullptr,
+                    within_bounds(start->parameters.calibration, stated_calibration), fit_settings);
       if (retry.cost < nominal.cost) nominal = std::move(retry);
     }
-    d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration);
+    d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration, stated_calibration);
   }
   d.nominal = nominal.parameters;
   // What a correct model would score on these held-out segments, from the capture's own
   // transducer noise and the spool flow noise.
   d.noise = predictor.noise_levels();
   d.channel_floor =
-      predictor.noise_floor(nominal.parameters, d.held_out_used, d.noise, settings.floor_seed);
+      predictor.noise_floor(nominal.parameters, d.held_out_used, d.noise, settings.floor_seed,
+                            settings.floor_repeats, settings.floor_noise_pieces);
   d.nrmse_floor = (d.channel_floor[0] + d.channel_floor[1] + d.channel_floor[2]) / 3.0;
   const std::vector<double> nominal_errors =
       segment_errors(predictor, nominal.parameters, d.held_out_used);
+
+  // Effects that start inside the capture: where the calibrated nominal model's error steps up
+  // at some time and stays up, the leading screened effects are also fitted from that time on
+  // (onset variants, judged on held-out data against the constant ones like any variant). A
+  // segment's error follows its operating point (a large step against a rest) far more than a
+  // fault's onset, so the split is also sought in what a leading (constant) candidate gains
+  // per segment over the nominal model: about nothing before the onset, and its gain after it.
+  std::vector<EffectCandidate> candidates = library;
+  const std::vector<Segment> in_time = segments_in_time_order(d.plan);
+  std::vector<std::size_t> order(library.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return screened[a].cost < screened[b].cost;
+  });
+  // The leading screened effects, one variant each; neither a ripple (found by its line) nor
+  // the oil (by its temperature) starts at a time.
+  std::vector<std::size_t> leading;
+  for (const std::size_t i : order) {
+    const auto& base = library[i];
+    if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
+    const bool seen = std::any_of(leading.begin(), leading.end(),
+                                  [&](std::size_t j) { return library[j].effect == base.effect; });
+    if (!seen) leading.push_back(i);
+    if (leading.size() >= settings.onset_candidates) break;
+  }
+  {
+    const auto errors = segment_errors(predictor, nominal.parameters, in_time);
+    std::vector<double> logs;
+    for (double e : errors) logs.push_back(std::log(std::max(e, 1e-300)));
+    d.change_point = find_change_point(record, in_time, logs);
+    for (std::size_t k = 0; k < std::min(leading.size(), settings.change_candidates); ++k) {
+      const auto gained = segment_errors(predictor, screened[leading[k]].parameters, in_time);
+      std::vector<double> gains;
+      for (std::size_t i = 0; i < gained.size(); ++i) {
+        gains.push_back(logs[i] - std::log(std::max(gained[i], 1e-300)));
+      }
+      const auto split = find_change_point(record, in_time, gains);
+      if (split && (!d.change_point || split->statistic > d.change_point->statistic)) {
+        d.change_point = split;
+      }
+    }
+  }
+  if (d.change_point && d.change_point->statistic >= settings.min_change_statistic) {
+    for (const std::size_t i : leading) {
+      EffectCandidate variant = library[i];
+      variant.onset_s = d.change_point->t_s;
+      screened.push_back(fit_model(predictor, screening_segments, &variant, catalogue, screening));
+      candidates.push_back(std::move(variant));
+    }
+  }
 
   const auto score = [&](const EffectCandidate& candidate, FitResult fit) {
     RankedEffect r;
@@ -207,8 +313,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   // Best variant of each effect (e.g. the chamber that leaks), by held-out error.
   std::map<std::string, RankedEffect> best;
   std::map<std::string, EffectCandidate> best_candidate;
-  for (std::size_t i = 0; i < library.size(); ++i) {
-    const auto& candidate = library[i];
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const auto& candidate = candidates[i];
     RankedEffect r = score(candidate, std::move(screened[i]));
     auto it = best.find(candidate.effect);
     if (it == best.end() || r.score > it->second.score) {
@@ -237,7 +343,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     p.calibration = calibration;
     std::vector<double> values;
     for (const auto& fp : candidate.parameters) values.push_back(fp.initial);
-    candidate.apply(p.effects, values);
+    candidate.apply(p, values);
     double sum = 0.0;
     for (double e : segment_errors(predictor, p, d.fitting_used)) sum += e;
     return sum;
@@ -412,6 +518,51 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     current = std::move(best_fit);
   }
 
+  // An effect named with an onset: the onset searched on every segment around the proposal
+  // (fitting and held-out alike: the time is not a model parameter the held-out score judges),
+  // the named model's error summed over them for each trial onset. An effect that shows only
+  // while the piston moves (a slower spool, a dead band) changes nothing during a hold, where
+  // the sum is flat: the onset is then the middle of the flat stretch around the minimum (the
+  // change is known to within it, not better).
+  if (named) {
+    for (auto& part : chosen) {
+      if (part.onset_s <= 0.0) continue;
+      std::vector<Segment> near;
+      for (const auto& seg : in_time) {
+        const double begin = record.t[seg.begin];
+        const double end = begin + static_cast<double>(seg.length) * record.dt;
+        if (end > part.onset_s - settings.onset_search_s - 0.5 &&
+            begin < part.onset_s + settings.onset_search_s + 0.5) {
+          near.push_back(seg);
+        }
+      }
+      ModelParameters trial = current.parameters;
+      const double step = settings.onset_step_s;
+      const auto steps = static_cast<int>(std::lround(settings.onset_search_s / step));
+      std::vector<std::pair<double, double>> sums;  // onset, summed error
+      for (int i = -steps; i <= steps; ++i) {
+        trial.onset_s = part.onset_s + i * step;
+        if (trial.onset_s <= record.t.front() || trial.onset_s >= record.t.back()) continue;
+        double sum = 0.0;
+        for (double e : segment_errors(predictor, trial, near)) sum += e;
+        sums.emplace_back(trial.onset_s, sum);
+      }
+      if (sums.empty()) continue;
+      std::size_t lowest = 0;
+      for (std::size_t i = 1; i < sums.size(); ++i) {
+        if (sums[i].second < sums[lowest].second) lowest = i;
+      }
+      double highest = sums[lowest].second;
+      for (const auto& [onset, sum] : sums) highest = std::max(highest, sum);
+      const double flat =
+          sums[lowest].second + settings.onset_flat_share * (highest - sums[lowest].second);
+      std::size_t first = lowest, last = lowest;
+      while (first > 0 && sums[first - 1].second <= flat) --first;
+      while (last + 1 < sums.size() && sums[last + 1].second <= flat) ++last;
+      part.onset_s = 0.5 * (sums[first].first + sums[last].first);
+    }
+  }
+
   FitSettings with_errors = fit_settings;
   with_errors.uncertainties = true;
   if (named) {
@@ -424,7 +575,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
       FitResult part;
       part.values = shares[p];
       part.value_errors = share_errors[p];
-      d.causes.push_back({chosen[p].effect, named_values(chosen[p], part)});
+      d.causes.push_back({chosen[p].effect, named_values(chosen[p], part), chosen[p].onset_s});
     }
     d.cause = d.causes.front().effect;
     d.params = d.causes.front().params;
@@ -438,7 +589,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   }
   if (!fit_settings.free_calibration[2]) d.calibrated_errors.m = d.force_balance.m_error;
   d.nrmse_after = predictor.nrmse(d.extended, d.held_out_used);
-  d.at_bound = calibration_at_bound(d.calibrated);
+  d.at_bound = calibration_at_bound(d.calibrated, stated_calibration);
 
   // Drift: the calibration fitted on the first and on the last third of the capture. Where it
   // moves, a named cause must hold still over the capture too, or the misfit is a changing
@@ -483,7 +634,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
   std::array<double, 3> extended_floor = d.channel_floor;
   if (named) {
     extended_floor =
-        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed);
+        predictor.noise_floor(d.extended, d.held_out_used, d.noise, settings.floor_seed,
+                              settings.floor_repeats, settings.floor_noise_pieces);
   }
   const double extended_reach =
       settings.floor_factor * (extended_floor[0] + extended_floor[1] + extended_floor[2]) / 3.0;
@@ -500,8 +652,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
     const EffectCandidate joint = chosen.size() == 1 ? chosen.front() : combine(chosen);
     const FitResult fe = fit_model(predictor, early, &joint, d.calibrated, with_errors);
     const FitResult fl = fit_model(predictor, late, &joint, d.calibrated, with_errors);
-    cause_moves = compare(joint.parameters.front().name, fe.values[0], fe.value_errors[0],
-                          fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
+    // A cause with an onset is absent from the thirds before it: its main parameter is not
+    // asked to hold still, its model's calibration is (below).
+    if (chosen.front().onset_s <= 0.0) {
+      cause_moves = compare(joint.parameters.front().name, fe.values[0], fe.value_errors[0],
+                            fl.values[0], fl.value_errors[0], settings.drift_effect_relative);
+    }
     // The named model's own calibration moving as the nominal one did: the constant fault
     // named does not account for the change, the oil's properties (beta, the damping b) do
     // (warm-ups without `temp` were named sensor_offset or entrained_air, the misfit left
@@ -545,6 +701,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const DiagnosisSettings& settin
         d.drifts ||
         (std::abs(d.unexplained->trend_t) > 3.0 &&
          (d.unexplained->late_over_early > 2.0 || d.unexplained->late_over_early < 0.5));
+  }
+  // A contradicted stated value is a cause of its own, ahead of the effects judged on the
+  // corrected rig (FORMATS.md); the comparison starts from the rig the user described.
+  if (!d.rig_check.findings.empty()) {
+    std::vector<NamedCause> rig_causes;
+    for (const auto& finding : d.rig_check.findings) rig_causes.push_back(rig_cause(finding));
+    d.causes.insert(d.causes.begin(), rig_causes.begin(), rig_causes.end());
+    d.cause = d.causes.front().effect;
+    d.params = d.causes.front().params;
+    d.nrmse_before = d.nrmse_stated;
   }
   return d;
 }

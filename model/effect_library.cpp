@@ -37,6 +37,7 @@ EffectCandidate combine(const std::vector<EffectCandidate>& parts) {
   EffectCandidate joint;
   for (const auto& part : parts) {
     joint.effect += (joint.effect.empty() ? "" : "+") + part.effect;
+    joint.onset_s = std::max(joint.onset_s, part.onset_s);
     joint.parameters.insert(joint.parameters.end(), part.parameters.begin(), part.parameters.end());
     joint.parts.push_back(part);
   }
@@ -86,16 +87,46 @@ void EffectCandidate::apply(EffectParameters& e, const std::vector<double>& valu
   }
 }
 
+RigScales RigScales::of(const sim::Parameters& rig) {
+  const sim::Parameters paper;
+  RigScales s;
+  if (rig.Kv != paper.Kv) s.leak = rig.Kv / paper.Kv;
+  const double span = rig.ps - rig.pt, paper_span = paper.ps - paper.pt;
+  if (rig.A() != paper.A() || span != paper_span)
+    s.force = rig.A() * span / (paper.A() * paper_span);
+  if (rig.Kv != paper.Kv || span != paper_span) {
+    s.droop =
+        (span / (rig.Kv * std::sqrt(span))) / (paper_span / (paper.Kv * std::sqrt(paper_span)));
+  }
+  if (rig.u_max != paper.u_max) s.command = rig.u_max / paper.u_max;
+  return s;
+}
+
+void EffectCandidate::apply(ModelParameters& p, const std::vector<double>& values) const {
+  if (!parts.empty()) {
+    const auto shares = split(values);
+    for (std::size_t i = 0; i < parts.size(); ++i) parts[i].apply(p, shares[i]);
+    return;
+  }
+  apply(p.effects, values);
+  if (onset_s > 0.0) {
+    p.onset_s = onset_s;
+  } else {
+    apply(p.before, values);
+  }
+}
+
 double EffectCandidate::smallest() const {
-  // A fifth of each range's low end (MODEL.md's effect library). The evaluation's `beyond`
-  // class draws at the low end / 1.5, so every instance it draws stays well above this.
-  if (effect == "internal_leakage") return 5e-13 / 5.0;
-  if (effect == "external_leakage") return 1e-13 / 5.0;
-  if (effect == "coulomb_friction") return 50.0 / 5.0;
+  // A fifth of each range's low end (MODEL.md's effect library), on another rig times the
+  // effect's size there. The evaluation's `beyond` class draws at the low end / 1.5, so every
+  // instance it draws stays well above this.
+  if (effect == "internal_leakage") return size * 5e-13 / 5.0;
+  if (effect == "external_leakage") return size * 1e-13 / 5.0;
+  if (effect == "coulomb_friction") return size * 50.0 / 5.0;
   if (effect == "entrained_air") return 0.02 / 5.0;
   if (effect == "valve_overlap") return 0.01 / 5.0;
-  if (effect == "valve_bias") return 0.05 / 5.0;
-  if (effect == "supply_droop") return 5e9 / 5.0;
+  if (effect == "valve_bias") return size * 0.05 / 5.0;
+  if (effect == "supply_droop") return size * 5e9 / 5.0;
   if (effect == "sensor_offset") return 5e4 / 5.0;
   if (effect == "sensor_lag") return std::max(0.002 / 5.0, 0.5 * sample_period);
   return 0.0;  // spool lag: slower than the nominal spool; ripple: its line test
@@ -114,7 +145,7 @@ bool EffectCandidate::plausible(const std::vector<double>& values) const {
   // A main parameter pinned at a bound means the effect's shape does not fit the data.
   const double span = p.upper - p.lower;
   if (main <= p.lower + 1e-3 * span || main >= p.upper - 1e-3 * span) return false;
-  if (effect == "spool_lag") return main > 1.5 * 2.5e-3;  // slower than the nominal spool
+  if (effect == "spool_lag") return main > 1.5 * rig_spool_tau;  // slower than the rig's spool
   if (std::abs(main) < smallest()) return false;
   // Leaks, friction, air, dead band and droop have a sign; the solver may cross zero, but a
   // negative one is not an instance of the effect.
@@ -124,17 +155,38 @@ bool EffectCandidate::plausible(const std::vector<double>& values) const {
 }
 
 std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperature,
-                                            double sample_period) {
+                                            double sample_period, const sim::Parameters& rig) {
+  const RigScales k = RigScales::of(rig);
+  // A parameter's scale, start and bounds times the effect's size on this rig.
+  const auto sized = [](FreeParameter p, double size) {
+    p.scale *= size;
+    p.initial *= size;
+    p.lower *= size;
+    p.upper *= size;
+    return p;
+  };
   std::vector<EffectCandidate> out;
-  out.push_back({"internal_leakage", "", {{"C_L", 1e-12, 1e-12, -2e-12, 5e-11}}, {}});
+  out.push_back(
+      {"internal_leakage", "", {sized({"C_L", 1e-12, 1e-12, -2e-12, 5e-11}, k.leak)}, {}});
+  out.back().size = k.leak;
   for (const char* chamber : {"chamber 1", "chamber 2"}) {
-    out.push_back({"external_leakage", chamber, {{"C_E", 1e-12, 5e-13, -1e-12, 2e-11}}, {}});
+    out.push_back(
+        {"external_leakage", chamber, {sized({"C_E", 1e-12, 5e-13, -1e-12, 2e-11}, k.leak)}, {}});
+    out.back().size = k.leak;
   }
-  out.push_back({"coulomb_friction", "", {{"F_C", 100.0, 100.0, -200.0, 4000.0}}, {}});
+  out.push_back(
+      {"coulomb_friction", "", {sized({"F_C", 100.0, 100.0, -200.0, 4000.0}, k.force)}, {}});
+  out.back().size = k.force;
   out.push_back({"entrained_air", "", {{"alpha", 0.05, 0.05, -0.02, 1.0}}, {}});
   out.push_back({"valve_overlap", "", {{"d", 0.01, 0.01, -0.01, 0.2}}, {}});
-  out.push_back({"valve_bias", "", {{"u0", 0.1, 0.02, -3.0, 3.0}}, {}});
-  out.push_back({"spool_lag", "", {{"tau", 0.005, 0.006, 5e-4, 0.1}}, {}});
+  out.push_back({"valve_bias", "", {sized({"u0", 0.1, 0.02, -3.0, 3.0}, k.command)}, {}});
+  out.back().size = k.command;
+  // The true spool's time constant, in multiples of the rig's own (the paper's rig's literal
+  // values, 2.5 ms: scale 5 ms, start 6 ms, bounds 0.5-100 ms).
+  const double tau = rig.tau;
+  FreeParameter spool{"tau", 0.005, 0.006, 5e-4, 0.1};
+  if (tau != sim::Parameters{}.tau) spool = {"tau", 2.0 * tau, 2.4 * tau, 0.2 * tau, 40.0 * tau};
+  out.push_back({"spool_lag", "", {spool}, {}});
   if (ripple_hz > 0.0) {
     out.push_back({"supply_ripple",
                    "",
@@ -146,7 +198,8 @@ std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperatu
                     {"", 1e5, 0.0, -5e6, 5e6}},
                    {}});
   }
-  out.push_back({"supply_droop", "", {{"R_s", 1e10, 5e9, -5e9, 3e11}}, {}});
+  out.push_back({"supply_droop", "", {sized({"R_s", 1e10, 5e9, -5e9, 3e11}, k.droop)}, {}});
+  out.back().size = k.droop;
   for (const char* channel : {"p1", "p2"}) {
     out.push_back({"sensor_offset", channel, {{"offset", 1e5, 0.0, -3e6, 3e6}}, {}});
   }
@@ -156,7 +209,10 @@ std::vector<EffectCandidate> effect_library(double ripple_hz, bool has_temperatu
   if (has_temperature) {
     out.push_back({"oil_temperature", "", {{"visc_slope", 0.01, 0.045, 0.0, 0.12}}, {}});
   }
-  for (auto& candidate : out) candidate.sample_period = sample_period;
+  for (auto& candidate : out) {
+    candidate.sample_period = sample_period;
+    candidate.rig_spool_tau = tau;
+  }
   return out;
 }
 

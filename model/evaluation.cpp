@@ -18,6 +18,29 @@ bool CaseOutcome::parameter_within(double tolerance) const {
   return std::abs(estimate - true_value) <= tolerance * std::abs(true_value);
 }
 
+bool CaseOutcome::only_truth_named() const {
+  if (named_causes.size() != truths.size()) return false;
+  return std::all_of(truths.begin(), truths.end(), [&](const TrueEffect& t) {
+    return std::find(named_causes.begin(), named_causes.end(), t.effect) != named_causes.end();
+  });
+}
+
+double CaseOutcome::fitted_misstated() const {
+  for (const auto& f : rig_findings) {
+    if (f.parameter == misstated) return f.fitted;
+  }
+  return std::nan("");
+}
+
+bool CaseOutcome::misstatement_found(double tolerance) const {
+  if (misstated.empty() || rig_findings.size() != 1) return false;
+  const auto& f = rig_findings.front();
+  const bool only_rig = std::all_of(named_causes.begin(), named_causes.end(),
+                                    [](const std::string& n) { return n == "rig_parameter"; });
+  return only_rig && f.parameter == misstated &&
+         std::abs(f.fitted - misstated_true) <= tolerance * std::abs(misstated_true);
+}
+
 double main_estimate(const Diagnosis& d, const std::string& main_parameter) {
   for (const auto& p : d.params) {
     if (p.name == main_parameter) return p.value;
@@ -30,7 +53,7 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
   const SyntheticCase c = draw_case(seed, effect, case_settings);
   const MeasuredRecord record = measured_record(simulate_case(c));
   const auto start = std::chrono::steady_clock::now();
-  const Diagnosis d = diagnose(record, settings);
+  const Diagnosis d = diagnose(record, c.told, settings);
   CaseOutcome out;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.seed = seed;
@@ -38,7 +61,24 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
   out.named = d.cause;
   out.main_parameter = c.main_parameter;
   out.true_value = c.main_value;
+  // The main parameter of the true effect's cause (the first cause may be a rig_parameter).
   out.estimate = main_estimate(d, c.main_parameter);
+  for (const auto& cause : d.causes) {
+    if (!c.effects.empty() && cause.effect == c.effects.front().effect) {
+      for (const auto& p : cause.params) {
+        if (p.name == c.main_parameter) out.estimate = p.value;
+      }
+      out.onset_estimate = cause.onset_s;
+    }
+  }
+  const auto& rig = c.scenario.params;
+  out.rig = fmt::format("D={:.0f}mm ps={:.1f}MPa K_s={:.0f}kN/m m={:.3g}kg Kv={:.3g} tau={:.3g}ms",
+                        rig.D * 1e3, rig.ps * 1e-6, rig.K_s * 1e-3, rig.m, rig.Kv, rig.tau * 1e3);
+  out.misstated = c.misstated;
+  out.misstated_true = c.misstated_true;
+  out.misstated_stated = c.misstated_stated;
+  out.rig_findings = d.rig_check.findings;
+  out.onset_true = c.onset_s;
   out.nrmse_before = d.nrmse_before;
   out.nrmse_after = d.nrmse_after;
   for (const auto& r : d.ranking) {
@@ -59,7 +99,7 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
       }
     }
   }
-  const SegmentPredictor predictor(record);
+  const SegmentPredictor predictor(record, c.scenario.params);  // the true rig
   out.nrmse_true = predictor.nrmse(true_model(c), d.held_out_used);
   const double achievable = out.nrmse_before - out.nrmse_true;
   out.achieved = achievable > 0.0 ? (out.nrmse_before - out.nrmse_after) / achievable : 1.0;
@@ -77,15 +117,21 @@ std::string EvaluationSummary::csv() const {
   std::string out =
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
       "nrmse_after,seconds,leading,leading_score,leading_significance,line_z,nrmse_floor,"
-      "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate\n";
+      "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate,rig,misstated,"
+      "misstated_true,misstated_stated,rig_findings,onset_true,onset_estimate\n";
   for (const auto& c : cases) {
+    std::string findings;
+    for (const auto& f : c.rig_findings) {
+      findings += fmt::format("{}{}:{:.6g}", findings.empty() ? "" : "+", f.parameter, f.fitted);
+    }
     out += fmt::format(
         "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{},"
-        "{},{:.6g},{:.4f},{:.6g}\n",
+        "{},{:.6g},{:.4f},{:.6g},{},{},{:.6g},{:.6g},{},{:.3f},{:.3f}\n",
         c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z,
         c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps, c.kind, c.nrmse_true,
-        c.achieved, c.visc_estimate);
+        c.achieved, c.visc_estimate, c.rig, c.misstated, c.misstated_true, c.misstated_stated,
+        findings, c.onset_true, c.onset_estimate);
   }
   return out;
 }
@@ -135,9 +181,17 @@ std::string EvaluationSummary::markdown() const {
 }
 
 const std::vector<std::string>& case_kinds() {
-  static const std::vector<std::string> kinds = {
-      "library", "pair", "warmup_temp", "warmup_no_temp", "edge", "beyond", "clean"};
+  static const std::vector<std::string> kinds = {"library",        "pair",      "warmup_temp",
+                                                 "warmup_no_temp", "edge",      "beyond",
+                                                 "clean",          "misstated", "onset"};
   return kinds;
+}
+
+const std::vector<std::string>& onset_effects() {
+  static const std::vector<std::string> effects = {
+      "internal_leakage", "external_leakage", "coulomb_friction", "valve_overlap", "valve_bias",
+      "spool_lag",        "supply_droop",     "sensor_offset",    "sensor_lag"};
+  return effects;
 }
 
 std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::size_t n,
@@ -165,6 +219,14 @@ std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::
     return {names[n % names.size()], base};
   }
   if (kind == "clean") return {"none", base};
+  if (kind == "misstated") {
+    base.misstate = misstatements()[n % misstatements().size()].key;
+    return {"none", base};
+  }
+  if (kind == "onset") {
+    base.onset = true;
+    return {onset_effects()[n % onset_effects().size()], base};
+  }
   throw std::invalid_argument(fmt::format("unknown case class '{}'", kind));
 }
 
@@ -225,6 +287,12 @@ std::string EvaluationSummary::kind_markdown() const {
       } else if (kind == "clean") {
         target = "none";
         met += c.named == "none";
+      } else if (kind == "misstated") {
+        target = "rig_parameter names it, fitted within 10 %, nothing else named";
+        met += c.misstatement_found(0.10);
+      } else if (kind == "onset") {
+        target = "the effect named alone, onset within 2 s";
+        met += c.only_truth_named() && std::abs(c.onset_estimate - c.onset_true) <= 2.0;
       }
     }
     if (n == 0) continue;
@@ -257,6 +325,32 @@ std::string EvaluationSummary::targets_markdown() const {
       const std::string where = c.kind == "library" ? "" : " (" + c.kind + ")";
       counts["single effects: cause right" + where].add(c.named == c.truth);
       counts["single effects: main parameter within 25 %" + where].add(c.parameter_within(0.25));
+      counts["single effects: that effect alone named" + where].add(c.only_truth_named());
+    }
+    if (c.misstated.empty()) {
+      counts["told the true rig: no rig_parameter named"].add(c.rig_findings.empty());
+    }
+    if (c.kind == "misstated") {
+      bool named = false;
+      for (const auto& f : c.rig_findings) named = named || f.parameter == c.misstated;
+      const bool library = std::any_of(c.named_causes.begin(), c.named_causes.end(),
+                                       [](const std::string& n) { return n != "rig_parameter"; });
+      counts["misstated: rig_parameter names the value stated wrong"].add(named);
+      counts["misstated: " + c.misstated + " named"].add(named);
+      const double fitted = c.fitted_misstated();
+      counts["misstated: fitted within 10 % of the true value"].add(
+          named && std::abs(fitted - c.misstated_true) <= 0.1 * std::abs(c.misstated_true));
+      counts["misstated: no library effect named"].add(!library);
+      counts["misstated: all three"].add(c.misstatement_found(0.10));
+    }
+    if (c.kind == "onset") {
+      const bool named = std::any_of(c.named_causes.begin(), c.named_causes.end(),
+                                     [&](const std::string& n) { return n == c.truth; });
+      counts["onset: the effect named"].add(named);
+      counts["onset: named with its onset within 2 s"].add(
+          named && std::abs(c.onset_estimate - c.onset_true) <= 2.0);
+      counts["onset: the effect alone, onset within 2 s"].add(
+          c.only_truth_named() && std::abs(c.onset_estimate - c.onset_true) <= 2.0);
     }
     if (c.kind == "pair") {
       bool both = true;

@@ -38,7 +38,20 @@ struct CaseOutcome {
   bool drifts = false;
   std::string steps;     // forward selection: effect:score/t per step, ';'-separated
   std::string at_bound;  // calibrated values on a bound, joined by '+'
+  // Other rigs (issue 24): the rig (a few of its values, for the CSV), the value stated wrong
+  // and what the rig check found, the true onset and the one named with the true effect.
+  std::string rig;
+  std::string misstated;
+  double misstated_true = 0.0, misstated_stated = 0.0;
+  std::vector<RigFinding> rig_findings;
+  double onset_true = 0.0, onset_estimate = 0.0;
   bool named_correctly() const { return truth == named; }
+  // Exactly the true effects named: nothing else, no rig_parameter either.
+  bool only_truth_named() const;
+  // The mis-stated value named rig_parameter with its fitted value within `tolerance` of the
+  // truth, and nothing else (no library effect, no other stated value).
+  bool misstatement_found(double tolerance) const;
+  double fitted_misstated() const;  // the rig check's value for `misstated`, NaN when not found
   bool parameter_within(double tolerance) const;
 };
 
@@ -51,8 +64,14 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
 // The evaluation classes of issue 12: "library" (the eleven effects and none in turn),
 // "pair" (two visible effects), "warmup_temp" / "warmup_no_temp" (the oil warming up, with and
 // without the `temp` column), "edge" / "beyond" (an effect at / 1.5 times beyond its range's
-// ends), "clean".
+// ends), "clean"; and of issue 24: "misstated" (no effect, one stated value wrong, the keys of
+// misstatements() in turn), "onset" (one effect of onset_effects() appearing inside the
+// capture). `--rigs other` draws every class on other rigs (CaseSettings::other_rig).
 const std::vector<std::string>& case_kinds();
+// The effects the "onset" class makes appear inside a capture: those whose appearance changes
+// the signals beyond the noise (not entrained air and ripple, which are at the noise level even
+// when present throughout, nor the oil, which warms gradually).
+const std::vector<std::string>& onset_effects();
 // The n-th case of a class: its effect string and settings.
 std::pair<std::string, CaseSettings> case_of_kind(const std::string& kind, std::size_t n,
                                                   CaseSettings base);

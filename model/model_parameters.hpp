@@ -14,6 +14,10 @@ struct Calibration {
   double Kv = sim::Parameters{}.Kv;      // valve coefficient [m^3/(s sqrt(Pa))]
   double m = sim::Parameters{}.m;        // moving mass [kg]
   double b = sim::Parameters{}.b;        // viscous friction [N s/m]
+
+  // The calibratable values a rig table states (MODEL.md "Other rigs": calibrated within
+  // "Calibratable parameters"' ranges around them).
+  static Calibration of(const sim::Parameters& rig) { return {rig.beta, rig.Kv, rig.m, rig.b}; }
 };
 
 enum class PressureChannel { p1, p2 };
@@ -43,6 +47,11 @@ struct EffectParameters {
 struct ModelParameters {
   Calibration calibration;
   EffectParameters effects;
+  // An effect that starts inside the capture (FORMATS.md `onset_s`): before onset_s the model
+  // runs with `before` (the effects present from the start), from onset_s on with `effects`.
+  // 0: every effect is present from the start and `before` is unused.
+  double onset_s = 0.0;
+  EffectParameters before;
 };
 
 }  // namespace leakmon::model

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "model/result_json.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::model {
 namespace {
@@ -18,7 +19,7 @@ void write_file(const std::filesystem::path& path, const std::string& text) {
 }
 
 std::string residual_csv(const MeasuredRecord& r, const Diagnosis& d) {
-  const SegmentPredictor predictor(r);
+  const SegmentPredictor predictor(r, d.rig_check.assumed);
   Prediction before, after;
   predictor.predict(d.nominal, d.held_out_used, before);
   predictor.predict(d.extended, d.held_out_used, after);
@@ -49,6 +50,57 @@ std::string parameter_lines(const std::vector<NamedValue>& params) {
   return out;
 }
 
+// The rig the model check assumed (FORMATS.md: the report states it), what it checked and
+// what it changed from the stated values.
+std::string rig_section(const Diagnosis& d) {
+  const auto& c = d.rig_check;
+  std::string out = "## The rig\n\n";
+  out += fmt::format("Described as: {}{}.\n\n", sim::describe(d.rig),
+                     d.rig.source.empty() ? std::string() : " (" + d.rig.source + ")");
+  out += fmt::format(
+      "Checked against the data (MODEL.md \"Other rigs\"): the supply, from the chamber "
+      "levels p1 + p2 = ps + pt ({}: {:.4g} MPa at rest, {:.4g} MPa with the valve wide open, "
+      "for a stated {:.4g} MPa), and the load stiffness given the stated area, from the force "
+      "balance ({:.4g} +- {:.2g} kN/m for a stated {:.4g} kN/m; constant force {:.3g} N). Not "
+      "checkable from u, x, p1, p2: the bore alone, the stroke and volumes (they trade with "
+      "beta), u_max (trades with Kv); a slower spool or a larger null leakage is named as "
+      "spool_lag or internal_leakage.\n\n",
+      c.supply_column ? "from the ps column" : "from p1 + p2", c.sum_rest * 1e-6, c.sum_open * 1e-6,
+      (c.stated.ps + c.stated.pt) * 1e-6, c.balance.K_s * 1e-3, c.balance.K_s_error * 1e-3,
+      c.stated.K_s * 1e-3, c.balance.constant);
+  if (c.findings.empty()) {
+    out += "No stated value is contradicted: the model runs on the rig as described";
+    if (!d.rig_rejected.empty()) {
+      out += fmt::format(
+          " (a correction of {} was tried, and did not predict the held-out data better: "
+          "score {:.3f}, t {:.2f})",
+          d.rig_rejected.front().parameter, d.rig_score, d.rig_significance);
+    }
+    out += ".\n\n";
+  } else {
+    out +=
+        "**Stated values the data contradict** (cause `rig_parameter`; the effects below are "
+        "judged on the corrected rig):\n\n| parameter | stated | fitted | standard error "
+        "|\n|---|---|---|---|\n";
+    for (const auto& f : c.findings) {
+      out += fmt::format("| {} | {:.5g} | {:.5g} | {:.2g} |\n", f.parameter, f.stated, f.fitted,
+                         f.error);
+    }
+    out += fmt::format(
+        "\nThe calibrated nominal model on the stated rig scores a held-out NRMSE of {:.4f}, "
+        "on the corrected rig {:.4f} (score {:.3f}, t {:.2f}).\n\n",
+        d.nrmse_stated, d.nrmse_corrected, d.rig_score, d.rig_significance);
+  }
+  const auto [lower, upper] = calibration_bounds(Calibration::of(c.assumed));
+  out += fmt::format(
+      "Calibrated around the stated values (MODEL.md's ranges; the fit's bounds are twice "
+      "them): beta {:.4g} GPa ({:.3g}-{:.3g}), Kv {:.4g} ({:.3g}-{:.3g}), m {:.4g} kg "
+      "({:.3g}-{:.3g}), b {:.4g} N s/m ({:.3g}-{:.3g}).\n\n",
+      c.assumed.beta * 1e-9, lower.beta * 1e-9, upper.beta * 1e-9, c.assumed.Kv, lower.Kv, upper.Kv,
+      c.assumed.m, lower.m, upper.m, c.assumed.b, lower.b, upper.b);
+  return out;
+}
+
 std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
   std::string out = fmt::format("# Model check of {}\n\n", r.source);
   out += fmt::format(
@@ -56,6 +108,7 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
       "part and scored on {} held-out segments (open-loop simulation on the "
       "measured command from the measured state, see docs/model-check.md).\n\n",
       r.duration(), 1.0 / r.dt, d.fitting_used.size(), d.held_out_used.size());
+  out += rig_section(d);
   out += "## Verdict\n\n";
   out += fmt::format(
       "Noise floor: the held-out NRMSE that the noise alone leaves, from this capture's "
@@ -82,8 +135,14 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
         "held-out NRMSE from {:.4f} to {:.4f}.\n\n",
         d.cause, d.causes.size() > 1 ? "them" : "it", d.nrmse_before, d.nrmse_after);
     for (const auto& cause : d.causes) {
-      out += fmt::format("**{}**\n\n| parameter | fitted value | standard error |\n|---|---|---|\n",
-                         cause.effect);
+      if (cause.effect == "rig_parameter") continue;  // in "The rig" below
+      out += fmt::format(
+          "**{}**{}\n\n| parameter | fitted value | standard error |\n|---|---|---|\n",
+          cause.effect,
+          cause.onset_s > 0.0 ? fmt::format(", starting at t = {:.2f} s (absent before: the "
+                                            "residual plot marks the onset)",
+                                            cause.onset_s)
+                              : std::string());
       out += parameter_lines(cause.params) + "\n";
     }
   }
@@ -145,8 +204,8 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
         "b = {:.4g} +- {:.2g} N s/m over {} windows{}.\n\n",
         d.force_balance.m, d.force_balance.m_error, d.force_balance.b, d.force_balance.b_error,
         d.force_balance.windows,
-        usable(d.force_balance) ? "; m is taken from it, b starts from it"
-                                : "; not usable here, so m is fitted");
+        usable(d.force_balance, d.rig_check.assumed.m) ? "; m is taken from it, b starts from it"
+                                                       : "; not usable here, so m is fitted");
   }
   if (d.ripple_line) {
     out += fmt::format(
@@ -175,7 +234,8 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
     out +=
         "## Where it shows\n\n"
         "![residual time series](residuals_time.png)\n\n"
-        "Residuals (simulation minus measurement) of the nominal and extended model.\n\n"
+        "Residuals (simulation minus measurement) of the nominal and extended model; a "
+        "vertical line marks where a named effect starts.\n\n"
         "![residuals against physical regressors](residuals_regressors.png)\n\n"
         "Nominal-model residuals against load pressure p1-p2, velocity, dp/dt, du/dt, "
         "command size and p1+p2: a leak follows load pressure, friction jumps with velocity "

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <string_view>
 
 namespace leakmon::model {
 namespace {
@@ -29,7 +30,8 @@ std::string errors_object(const std::vector<NamedValue>& params) {
   std::string out = "{";
   bool first = true;
   for (const auto& p : params) {
-    if (p.is_text() || p.name == "chamber") continue;
+    // Discrete values have no error, nor has a rig_parameter's stated value.
+    if (p.is_text() || p.name == "chamber" || p.name == "stated") continue;
     out += fmt::format("{}\"{}\": {}", first ? "" : ", ", p.name, number(p.error));
     first = false;
   }
@@ -68,17 +70,77 @@ std::string misfit_object(const Misfit& m) {
       channel_object(m.channel_nrmse), channel_object(m.channel_floor));
 }
 
+std::string json_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string findings_list(const std::vector<RigFinding>& findings) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < findings.size(); ++i) {
+    const auto& f = findings[i];
+    out += fmt::format("{}{{\"parameter\": \"{}\", \"stated\": {}, \"fitted\": {}, \"error\": {}}}",
+                       i ? ", " : "", f.parameter, number(f.stated), number(f.fitted),
+                       number(f.error));
+  }
+  return out + "]";
+}
+
+// The rig's keys with their values (sim::rig_value), every key of MODEL.md's table but the
+// data-sheet alternatives (valve rating, oil viscosities) that restate another.
+std::string rig_values(const sim::RigDescription& rig) {
+  std::string out = "{";
+  bool first = true;
+  for (const auto& key : sim::rig_keys()) {
+    if (key.symbol.empty()) continue;
+    const auto value = sim::rig_value(rig, key.key);
+    if (!value) continue;
+    out += fmt::format("{}\"{}\": {}", first ? "" : ", ", key.key, number(*value));
+    first = false;
+  }
+  return out + "}";
+}
+
+// What the model check assumed about the rig (FORMATS.md: the report states it): the
+// description, the values stated and assumed, the values checked and the evidence.
+std::string rig_object(const Diagnosis& d) {
+  sim::RigDescription assumed = d.rig;
+  assumed.params = d.rig_check.assumed;
+  const auto& c = d.rig_check;
+  return fmt::format(
+      "{{\"description\": {}, \"source\": {}, \"stated\": {}, \"assumed\": {}, "
+      "\"changed\": {}, \"not_confirmed\": {}, \"checked\": [\"supply_pressure\", "
+      "\"load_stiffness\"], \"evidence\": {{\"supply_from\": \"{}\", \"sum_rest\": {}, "
+      "\"sum_open\": {}, \"load_stiffness\": {}, \"load_stiffness_error\": {}, "
+      "\"constant_force\": {}, \"constant_force_error\": {}}}, \"nrmse_stated\": {}, "
+      "\"nrmse_corrected\": {}, \"score\": {}, \"significance\": {}}}",
+      json_string(sim::describe(d.rig)), json_string(d.rig.source), rig_values(d.rig),
+      rig_values(assumed), findings_list(c.findings), findings_list(d.rig_rejected),
+      c.supply_column ? "ps" : "p1+p2", number(c.sum_rest), number(c.sum_open),
+      number(c.balance.K_s), number(c.balance.K_s_error), number(c.balance.constant),
+      number(c.balance.constant_error), number(d.nrmse_stated), number(d.nrmse_corrected),
+      number(d.rig_score), number(d.rig_significance));
+}
+
 }  // namespace
 
 std::string diagnosis_json(const Diagnosis& d) {
   std::string out = "{\n";
   out += fmt::format("  \"cause\": \"{}\",\n", d.cause);
+  out += fmt::format("  \"rig\": {},\n", rig_object(d));
   out += fmt::format("  \"params\": {},\n", params_object(d.params));
   out += "  \"causes\": [";
   for (std::size_t i = 0; i < d.causes.size(); ++i) {
-    out += fmt::format("{}{{\"cause\": \"{}\", \"params\": {}, \"param_errors\": {}}}",
-                       i ? ", " : "", d.causes[i].effect, params_object(d.causes[i].params),
-                       errors_object(d.causes[i].params));
+    const auto& cause = d.causes[i];
+    out += fmt::format("{}{{\"cause\": \"{}\", \"params\": {}, \"param_errors\": {}{}}}",
+                       i ? ", " : "", cause.effect, params_object(cause.params),
+                       errors_object(cause.params),
+                       cause.onset_s > 0.0 ? fmt::format(", \"onset_s\": {}", number(cause.onset_s))
+                                           : std::string());
   }
   out += "],\n";
   out += "  \"steps\": [";
@@ -92,6 +154,12 @@ std::string diagnosis_json(const Diagnosis& d) {
   }
   out += "],\n";
   out += fmt::format("  \"nrmse_floor\": {},\n", number(d.nrmse_floor));
+  if (d.change_point) {
+    out +=
+        fmt::format("  \"change_point\": {{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}},\n",
+                    number(d.change_point->t_s), number(d.change_point->statistic),
+                    number(d.change_point->step));
+  }
   out += fmt::format("  \"unexplained\": {},\n",
                      d.unexplained ? misfit_object(*d.unexplained) : "null");
   out += fmt::format("  \"at_bound\": {},\n", string_list(d.at_bound));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
 namespace leakmon::model {
@@ -79,16 +80,24 @@ SegmentPredictor::SegmentPredictor(const MeasuredRecord& record, const sim::Para
   }
 }
 
-std::vector<double> SegmentPredictor::spool_positions(const ActuatorModel& model) const {
-  // Exact response of tau dxs/dt = sat((u + u0)/u_max) - xs to the held command.
+std::vector<double> SegmentPredictor::spool_positions(const ActuatorModel& model,
+                                                      const ActuatorModel* before,
+                                                      double onset_s) const {
+  // Exact response of tau dxs/dt = sat((u + u0)/u_max) - xs to the held command; with an
+  // onset, the spool of the model before it up to onset_s (a bias or a slower spool appears).
   const double decay = std::exp(-record_.dt / model.spool_tau());
+  const double decay_before = before ? std::exp(-record_.dt / before->spool_tau()) : decay;
   std::vector<double> xs(record_.size());
   double state = 0.0;
   double u = 0.0;
   for (std::size_t k = 0; k < record_.size(); ++k) {
     xs[k] = state;
     if (std::isfinite(record_.u[k])) u = record_.u[k];
-    state = decay * state + (1.0 - decay) * model.spool_input(u);
+    if (before && record_.t[k] < onset_s) {
+      state = decay_before * state + (1.0 - decay_before) * before->spool_input(u);
+    } else {
+      state = decay * state + (1.0 - decay) * model.spool_input(u);
+    }
   }
   return xs;
 }
@@ -96,15 +105,29 @@ std::vector<double> SegmentPredictor::spool_positions(const ActuatorModel& model
 template <typename Visit>
 void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Segment> segments,
                            Visit&& visit) const {
-  const ActuatorModel model(parameters, rig_);
-  const std::vector<double> xs = spool_positions(model);
-  const auto& e = parameters.effects;
+  const ActuatorModel after(parameters, rig_);
+  // An effect starting inside the capture: the model without it up to onset_s.
+  const bool switches = parameters.onset_s > 0.0;
+  std::optional<ActuatorModel> before;
+  if (switches) {
+    ModelParameters early = parameters;
+    early.effects = parameters.before;
+    early.onset_s = 0.0;
+    before.emplace(early, rig_);
+  }
+  const auto model_at = [&](double t) -> const ActuatorModel& {
+    return switches && t < parameters.onset_s ? *before : after;
+  };
+  const std::vector<double> xs =
+      spool_positions(after, switches ? &*before : nullptr, parameters.onset_s);
   // oil_temperature: the coefficients follow the measured oil temperature, sample by sample
   // (it changes over minutes; a missing reading holds the last one).
-  const bool follows_temperature = e.visc_slope > 0.0 && !record_.temp.empty();
-  sim::ActuatorCoefficients at_temperature = model.coefficients();
+  const bool follows_temperature = parameters.effects.visc_slope > 0.0 && !record_.temp.empty();
+  sim::ActuatorCoefficients at_temperature = after.coefficients();
   for (const auto& seg : segments) {
     const std::size_t k0 = seg.begin;
+    const ActuatorModel* model = &model_at(record_.t[k0]);
+    const auto& e = model->parameters().effects;
     ActuatorState s;
     s.xs = xs[k0];
     s.x = record_.x[k0];
@@ -123,14 +146,25 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
       const std::size_t k = k0 + j;
       if (!diverged && follows_temperature) {
         const double T = record_.temp[k - 1];
-        if (std::isfinite(T)) at_temperature = model.coefficients_at(T);
-        model.advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt, 0.0, at_temperature);
+        if (std::isfinite(T)) at_temperature = model->coefficients_at(T);
+        model->advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt, 0.0, at_temperature);
       } else if (!diverged) {
-        model.advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt);
+        model->advance(s, record_.u[k - 1], record_.t[k - 1], record_.dt);
         diverged = !(std::isfinite(s.x) && std::isfinite(s.p1) && std::isfinite(s.p2) &&
                      std::abs(s.x) < 10.0 * rig_.L && s.p1 < 1e9 && s.p2 < 1e9);
       }
-      visit(k, model.read(s), diverged);
+      if (switches) {
+        const ActuatorModel* now = &model_at(record_.t[k]);
+        if (now != model) {
+          // A transducer lag that starts now reads the pressure it starts from.
+          const auto& started = now->parameters().effects;
+          if (started.tau_s > 0.0 && model->parameters().effects.tau_s <= 0.0) {
+            s.s = started.lag_channel == PressureChannel::p1 ? s.p1 : s.p2;
+          }
+          model = now;
+        }
+      }
+      visit(k, model->read(s), diverged);
     }
   }
 }
@@ -243,7 +277,7 @@ NoiseLevels SegmentPredictor::noise_levels() const {
 std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& parameters,
                                                     std::span<const Segment> segments,
                                                     const NoiseLevels& noise, std::uint64_t seed,
-                                                    int repeats) const {
+                                                    int repeats, int pieces) const {
   const ActuatorModel model(parameters, rig_);
   const std::vector<double> xs = spool_positions(model);
   std::mt19937_64 random(seed);
@@ -281,9 +315,25 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
       guess.p1 += noise.p1 * normal(random);
       guess.p2 += noise.p2 * normal(random);
       double w = w_sigma * normal(random);
+      // Finer: the process itself at the pieces' spacing, each piece holding the mean of its
+      // two ends (the simulator interpolates its noise grid linearly).
+      const double piece = record_.dt / pieces;
+      const double piece_rho = std::exp(-piece / std::max(noise.spool_tau, 1e-9));
+      const double piece_innovation =
+          noise.spool_sigma * std::sqrt(std::max(1.0 - piece_rho * piece_rho, 0.0));
+      double w_end = noise.spool_sigma * normal(random);
       for (std::size_t j = 1; j < seg.length; ++j) {
         const std::size_t k = k0 + j;
-        model.advance(truth, record_.u[k - 1], record_.t[k - 1], record_.dt, w);
+        if (pieces <= 1) {
+          model.advance(truth, record_.u[k - 1], record_.t[k - 1], record_.dt, w);
+        } else {
+          for (int i = 0; i < pieces; ++i) {
+            const double w_start = w_end;
+            w_end = piece_rho * w_end + piece_innovation * normal(random);
+            model.advance(truth, record_.u[k - 1], record_.t[k - 1] + i * piece, piece,
+                          0.5 * (w_start + w_end));
+          }
+        }
         model.advance(guess, record_.u[k - 1], record_.t[k - 1], record_.dt);
         w = rho * w + w_innovation * normal(random);
         const Reading t = model.read(truth);

@@ -91,12 +91,17 @@ class SegmentPredictor {
   // transducer noise, against the same model's deterministic prediction from a start read
   // through that noise, i.e. what a correct model scores. Averaged over `repeats` draws. Per
   // channel (x, p1, p2); FORMATS.md's value is their mean, as for nrmse.
+  // `pieces`: the spool flow noise is held over this many equal parts of each sample (an
+  // exact Ornstein-Uhlenbeck draw at their spacing); 1 holds each sample's mean.
   std::array<double, 3> noise_floor(const ModelParameters& parameters,
                                     std::span<const Segment> segments, const NoiseLevels& noise,
-                                    std::uint64_t seed, int repeats = 3) const;
+                                    std::uint64_t seed, int repeats = 3, int pieces = 1) const;
 
  private:
-  std::vector<double> spool_positions(const ActuatorModel& model) const;
+  // `before`: the model up to onset_s, when an effect starts inside the capture.
+  std::vector<double> spool_positions(const ActuatorModel& model,
+                                      const ActuatorModel* before = nullptr,
+                                      double onset_s = 0.0) const;
   template <typename Visit>
   void run(const ModelParameters& parameters, std::span<const Segment> segments,
            Visit&& visit) const;

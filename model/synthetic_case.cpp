@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "model/effect_library.hpp"
+#include "sim/rig_draw.hpp"
 #include "sim/simulate.hpp"
 
 namespace leakmon::model {
@@ -27,7 +30,17 @@ class Draw {
   std::mt19937_64 engine_;
 };
 
+// A stream of the case's seed for the other rig, apart from the draws below (so that the
+// paper's cases draw exactly what they drew before other rigs existed).
+constexpr std::uint64_t kOtherRigStream = 0x6f746865722d7267ULL;  // "other-rg"
+
 }  // namespace
+
+const std::vector<Misstatement>& misstatements() {
+  static const std::vector<Misstatement> list = {{"supply_pressure", 0.15, 0.30},
+                                                 {"load_stiffness", 0.40, 0.80}};
+  return list;
+}
 
 SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
                         const CaseSettings& settings) {
@@ -47,11 +60,42 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
   s.controller = draw.coin() ? sim::ControllerKind::basic : sim::ControllerKind::fault_tolerant;
   s.duration_s = settings.duration_s;
   s.seed = draw.seed();
+  if (settings.other_rig) {
+    // Another rig the controller runs, drawn from its own stream; a spring to mis-state.
+    Draw rig_draw(seed ^ kOtherRigStream);
+    sim::OtherRig other = sim::draw_other_rig(rig_draw.seed(), s.controller);
+    while (settings.misstate == "load_stiffness" && other.rig.params.K_s <= 0.0) {
+      other = sim::draw_other_rig(rig_draw.seed(), s.controller);
+    }
+    const sim::Scenario on_rig = sim::other_rig_scenario(other, s.controller, s.duration_s, s.seed);
+    s.rig = on_rig.rig;
+    s.params = on_rig.params;
+    s.conditions = on_rig.conditions;
+    s.reference = on_rig.reference;
+    s.sensors = on_rig.sensors;
+  }
+  c.told = s.rig;
   // Calibratable parameters within MODEL.md's ranges: not a discrepancy to report.
   s.params.beta *= draw.uniform(0.75, 1.25);
   s.params.Kv *= draw.uniform(0.9, 1.1);
   s.params.m *= draw.uniform(0.8, 1.2);
   s.params.b *= draw.uniform(0.7, 1.3);
+  if (!settings.misstate.empty()) {
+    const auto known =
+        std::find_if(misstatements().begin(), misstatements().end(),
+                     [&](const Misstatement& m) { return m.key == settings.misstate; });
+    if (known == misstatements().end()) {
+      throw std::invalid_argument(fmt::format("no misstatement of '{}'", settings.misstate));
+    }
+    const double off = draw.uniform(known->low, known->high);
+    const double factor = draw.coin() ? 1.0 + off : 1.0 - off;
+    c.misstated = known->key;
+    c.misstated_true = *sim::rig_value(c.told, known->key);
+    c.told = sim::misstate(c.told, known->key, factor);
+    c.misstated_stated = *sim::rig_value(c.told, known->key);
+  }
+  // How large each effect is on this rig (the paper's: 1).
+  const RigScales size = RigScales::of(s.params);
 
   auto& e = s.effects;
   // The main parameter's value: drawn within MODEL.md's range, or (settings.edge > 0) at its
@@ -78,25 +122,30 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
       return value;
     };
     if (part == "internal_leakage") {
-      e.internal_leakage = sim::InternalLeakage{set_main("C_L", in_range(5e-13, 5e-12, true))};
+      e.internal_leakage =
+          sim::InternalLeakage{set_main("C_L", size.leak * in_range(5e-13, 5e-12, true))};
     } else if (part == "external_leakage") {
-      const double ce = set_main("C_E", in_range(1e-13, 2e-12, true));
+      const double ce = set_main("C_E", size.leak * in_range(1e-13, 2e-12, true));
       e.external_leakage = sim::ExternalLeakage{ce, draw.coin() ? 1 : 2};
     } else if (part == "coulomb_friction") {
-      e.coulomb_friction = sim::CoulombFriction{set_main("F_C", in_range(50.0, 400.0, false))};
+      e.coulomb_friction =
+          sim::CoulombFriction{set_main("F_C", size.force * in_range(50.0, 400.0, false))};
     } else if (part == "entrained_air") {
       e.entrained_air = sim::EntrainedAir{set_main("alpha", in_range(0.02, 0.2, true))};
     } else if (part == "valve_overlap") {
       e.valve_overlap = sim::ValveOverlap{set_main("d", in_range(0.01, 0.05, false))};
     } else if (part == "valve_bias") {
-      e.valve_bias = sim::ValveBias{set_main("u0", draw.sign() * in_range(0.05, 0.3, false))};
+      e.valve_bias =
+          sim::ValveBias{set_main("u0", size.command * draw.sign() * in_range(0.05, 0.3, false))};
     } else if (part == "spool_lag") {
-      e.spool_lag = sim::SpoolLag{set_main("tau", in_range(0.006, 0.015, false))};
+      // The paper's 6-15 ms for its 2.5 ms spool: 2.4-6 times the rig's own.
+      e.spool_lag = sim::SpoolLag{
+          set_main("tau", s.params.tau / sim::Parameters{}.tau * in_range(0.006, 0.015, false))};
     } else if (part == "supply_ripple") {
       const double dp = set_main("dP", in_range(2e5, 1e6, false));
       e.supply_ripple = sim::SupplyRipple{dp, draw.uniform(20.0, 200.0)};
     } else if (part == "supply_droop") {
-      e.supply_droop = sim::SupplyDroop{set_main("R_s", in_range(5e9, 3e10, true))};
+      e.supply_droop = sim::SupplyDroop{set_main("R_s", size.droop * in_range(5e9, 3e10, true))};
     } else if (part == "sensor_offset") {
       const double offset = set_main("offset", draw.sign() * in_range(5e4, 3e5, false));
       e.sensor_offset = sim::SensorOffset{offset, channel()};
@@ -125,16 +174,41 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
     c.main_parameter = c.effects.front().main_parameter;
     c.main_value = c.effects.front().main_value;
   }
+  if (settings.onset && e.any()) {
+    // The effects appear inside the capture: none before the onset, all of them after it.
+    const double dt = 1.0 / s.sample_rate_hz;
+    c.onset_s = std::round(draw.uniform(0.2, 0.8) * settings.duration_s / dt) * dt;
+    s.change = sim::EffectChange{c.onset_s, e};
+    e = sim::Effects{};
+  }
   return c;
 }
 
 capture::Capture simulate_case(const SyntheticCase& c) { return sim::simulate(c.scenario); }
 
+std::string rig_file_text(const sim::RigDescription& rig) {
+  std::string out = fmt::format("# {}\nrig:\n", sim::describe(rig));
+  for (const auto& key : sim::rig_keys()) {
+    if (key.symbol.empty()) continue;  // the valve's rating and the oil: below
+    out += fmt::format("  {}: {:.9g}\n", key.key, *sim::rig_value(rig, key.key));
+  }
+  if (const auto grade = sim::rig_value(rig, "oil_grade")) {
+    out += fmt::format("  oil_grade: {:g}\n", *grade);
+  } else {
+    out += fmt::format("  oil_viscosity_40: {:.9g}\n  oil_viscosity_100: {:.9g}\n", rig.oil.nu40(),
+                       rig.oil.nu100());
+  }
+  return out;
+}
+
 ModelParameters true_model(const SyntheticCase& c) {
   const auto& s = c.scenario;
   ModelParameters m;
   m.calibration = {s.params.beta, s.params.Kv, s.params.m, s.params.b};
-  const auto& e = s.effects;
+  // Effects that appear inside the capture: the true model switches at their onset (the
+  // effects before it are none, as drawn).
+  if (s.change) m.onset_s = s.change->t_s;
+  const auto& e = s.change ? s.change->effects : s.effects;
   auto& t = m.effects;
   const auto channel = [](sim::PressureChannel ch) {
     return ch == sim::PressureChannel::p1 ? PressureChannel::p1 : PressureChannel::p2;

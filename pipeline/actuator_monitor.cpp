@@ -10,6 +10,7 @@
 
 #include "capture/units.hpp"
 #include "detect/factory.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::pipeline {
 namespace {
@@ -29,12 +30,18 @@ std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
   const double hop_seconds =
       static_cast<double>(config.features.step) * static_cast<double>(period_ns) / 1e9;
   const config::ConfigNode* options = config.detector_options ? &*config.detector_options : nullptr;
-  return detect::make_detector(config.detector, signals, hop_seconds, options);
+  return detect::make_detector(config.detector, signals, hop_seconds, options, &config.rig);
 }
 
 // Learning hops the mode verdict needs at least (1 s at the default hop of 40 ms); with fewer the
 // rig stays unjudged.
 constexpr std::size_t kModeJudgedHops = 25;
+
+// The mode of a rig that `rig:` describes; NaN for the paper's (nothing stated).
+double rig_mode_hz(const sim::RigDescription& rig) {
+  if (rig.nominal()) return kNaN;
+  return sim::hydraulic_mode_hz(rig.params);
+}
 
 ModeVisibilityCheck mode_check(const detect::TransducerSpec& spec) {
   return ModeVisibilityCheck(
@@ -65,6 +72,12 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       watch_mode_(detector_->needs_hydraulic_mode()),
       mode_checks_{mode_check(config.transducers[Role::p1]),
                    mode_check(config.transducers[Role::p2])},
+      rig_mode_hz_(rig_mode_hz(config.rig)),
+      mode_out_of_band_([&] {
+        const auto band = ModeVisibilityCheck::readable_band(1e9 / static_cast<double>(period_ns),
+                                                             config.features.level);
+        return rig_mode_hz_ < band.low || rig_mode_hz_ > band.high;
+      }()),
       period_ns_(period_ns) {
   const double rate = sample_rate_hz_;
   channels_.reserve(3);
@@ -245,6 +258,19 @@ void ActuatorMonitor::judge_mode_visibility(double t, const detect::Observation&
   event.channel = "p1";
   const double floor = mode_checks_[0].noise_floor();
   event.baseline = healthy_index_ratio_ * floor;
+  if (mode_out_of_band_) {
+    const auto band = ModeVisibilityCheck::readable_band(sample_rate_hz_, config_.features.level);
+    event.message = fmt::format(
+        "{}: the rig's hydraulic mode, {:.0f} Hz at mid-stroke from its rig: (bulk modulus, "
+        "area, volumes, mass), lies outside the {:.0f}-{:.0f} Hz the level-{} details of the "
+        "index read (median index while learning {:.1f} kPa, {:.1f} x the transducer's noise): "
+        "the {} detector sees a leak only through that mode, so {} cannot be raised on this "
+        "rig; acquire the valve command u and the position x for the flow balance",
+        config_.name, rig_mode_hz_, band.low, band.high, config_.features.level,
+        event.baseline / 1e3, healthy_index_ratio_, detector_->name(), config_.alarm_name);
+    publish(event);
+    return;
+  }
   event.message = fmt::format(
       "{}: the hydraulic mode hardly shows in the chamber pressures (median index while "
       "learning {:.1f} kPa, {:.1f} x the transducer's noise of {:.1f} kPa; below {:.1f} x no "
@@ -337,7 +363,9 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
     ++suspended_decisions_;
     return;
   }
+  const bool was_learning = last_decision_.learning;
   last_decision_ = detector_->update(observation);
+  if (was_learning && !last_decision_.learning) learning_ended_t_ = t;
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
   if (watch_mode_) judge_mode_visibility(t, observation, publish);
@@ -428,6 +456,8 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.detector = detector_->name();
   status.state = alarm_.state();
   status.learning = last_decision_.learning;
+  status.learning_seconds = learning_seconds();
+  status.learning_ended_t = learning_ended_t_;
   status.raise_threshold = alarm_.settings().raise_threshold;
   status.clear_threshold = alarm_.settings().clear_threshold;
   status.t = last_t_;

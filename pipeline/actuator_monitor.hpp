@@ -59,6 +59,11 @@ struct ActuatorStatus {
   bool learning = true;
   // Source seconds until the detector decides: 0 once it does, NaN before the first sample.
   double learning_seconds_left = io::kNoValue;
+  // How long learning takes from the first sample (the features' first window and the
+  // detector's settling and learning), and the source time it ended (NaN: not yet, or resumed
+  // from a learned state).
+  double learning_seconds = io::kNoValue;
+  double learning_ended_t = io::kNoValue;
   double raise_threshold = io::kNoValue;  // the score at which the alarm raises
   double clear_threshold = io::kNoValue;
   double t = io::kNoValue;         // source time of the newest decision
@@ -154,7 +159,8 @@ class ActuatorMonitor {
   void judge_mode_visibility(double t, const detect::Observation& observation,
                              const EventPublisher& publish);
   bool detection_blind() const {
-    return watch_mode_ && healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio;
+    return watch_mode_ &&
+           (mode_out_of_band_ || healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio);
   }
 
   ActuatorConfig config_;
@@ -197,6 +203,10 @@ class ActuatorMonitor {
   // Only for a detector that needs the hydraulic mode (watch_mode_): p1's and p2's checks.
   bool watch_mode_;
   std::array<ModeVisibilityCheck, 2> mode_checks_;
+  // The described rig's mode (NaN for the paper's rig, whose mode is not in question) and
+  // whether it lies outside what the index reads (ModeVisibilityCheck::readable_band).
+  double rig_mode_hz_;
+  bool mode_out_of_band_;
   bool mode_judged_ = false;
   double healthy_index_ratio_ = io::kNoValue;
   bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision
@@ -222,6 +232,7 @@ class ActuatorMonitor {
   double newest_t_ = io::kNoValue;
   double protected_from_ = io::kNoValue;  // source time of the first decision (expected)
   std::uint64_t relearns_ = 0;
+  double learning_ended_t_ = io::kNoValue;
 };
 
 }  // namespace leakmon::pipeline

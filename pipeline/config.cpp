@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "sim/sensors.hpp"
+
 namespace leakmon::pipeline {
 
 capture::ByRole<detect::TransducerSpec> default_transducers() {
@@ -26,6 +28,27 @@ detect::AvailableSignals available_signals(const capture::ByRole<bool>& acquired
   signals.u = acquired[Role::u];
   signals.x = acquired[Role::x];
   return signals;
+}
+
+namespace {
+
+// The pressure transducers a rig that states its supply is fitted with: 12 bit over the usual
+// range above its supply (sim::sensors_for: MODEL.md's 0-20.7 MPa for the paper's 17.2 MPa), as
+// the simulator assumes for it.
+detect::TransducerSpec pressure_transducer_for(const sim::RigDescription& rig) {
+  detect::TransducerSpec spec = detect::TransducerSpec::pressure();
+  if (!rig.states("supply_pressure")) return spec;
+  spec.max = sim::sensors_for(rig.params).pressure_full_scale;
+  spec.resolution = spec.max / 4096.0;
+  return spec;
+}
+
+}  // namespace
+
+void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig) {
+  actuator.rig = std::move(rig);
+  actuator.transducers[capture::Role::p1] = actuator.transducers[capture::Role::p2] =
+      pressure_transducer_for(actuator.rig);
 }
 
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver) {

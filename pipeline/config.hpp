@@ -17,6 +17,7 @@
 #include "detect/sensor_plausibility.hpp"
 #include "dsp/streaming_features.hpp"
 #include "pipeline/alarm.hpp"
+#include "sim/rig_description.hpp"
 
 namespace leakmon::pipeline {
 
@@ -62,11 +63,17 @@ struct ActuatorConfig {
   dsp::FeatureParams features;
   std::string detector = "default";
   std::optional<config::ConfigNode> detector_options;
+  // The rig's description (`rig:`, FORMATS.md): the base of the detector's supply, tank pressure,
+  // valve, piston area, command full scale and oil, which detector options of the same values
+  // override (detect/rig_options.hpp); the paper's rig when absent. A stated supply also sets
+  // the pressure transducers' default range (sim::sensors_for).
+  sim::RigDescription rig;
   // Thresholds left NaN take the detector's own.
   AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   std::string alarm_name = "internal_leakage";
   // The transducers behind the checked roles (kCheckedRoles), for their plausibility checks
-  // (`transducers:`).
+  // (`transducers:`); the pressures 12 bit over the rig's standard range when `rig:` states the
+  // supply.
   capture::ByRole<detect::TransducerSpec> transducers = default_transducers();
 
   // Which roles the actuator acquires.
@@ -110,6 +117,10 @@ struct DaemonConfig {
   std::vector<ActuatorConfig> actuators;
   std::string event_log;  // JSON-lines file; empty: none
   std::optional<config::ConfigNode> event_log_where;
+  // Legal but probably wrong (two Modbus channels on the same registers, a value given both in
+  // `rig:` and in the detector's options), each `file:line:column: message`; check-config prints
+  // them, run logs them at start.
+  std::vector<std::string> warnings;
   RecordingConfig recording;
   StateConfig state{config::default_state_directory(), 60.0, std::nullopt};
   MetricsConfig metrics;
@@ -125,6 +136,12 @@ struct DaemonConfig {
   // asks); negative: no request, the power management stays as the system has it.
   int cpu_wakeup_latency_us = 0;
 };
+
+// Sets the actuator's rig and what follows from it where nothing else is configured: the
+// pressure transducers' range (12 bit over sim::sensors_for's range for a stated supply).
+// daemon::parse_config calls it before it reads `transducers:`; `leakmon replay --rig` on the
+// built-in defaults, and the evaluation on a told rig.
+void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig);
 
 // The group that holds `driver`, or nullptr.
 const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver);

@@ -22,6 +22,14 @@
 //   - seal friction 50-400 N: 1.6-2.1;
 //   - a soft rig (beta -25 %, b +30 %) with free air alpha 0.2: 2.0.
 // On the last two, a 5e-12 leak went unseen by every pressure-only detector.
+//
+// On another rig the mode itself moves (MODEL.md "Other rigs": with m, A, beta and the volumes).
+// Far out of the band the index falls to the noise floor and the ratio says so; near the band's
+// edges it does not: a 50 mm bore with 80 kg (mode 44.8 Hz) kept the ratio above 2.5 while a
+// 3e-12 leak was found in none of 3 runs within 60 s by either pressure-only detector
+// (docs/detection.md, "Other rigs"). So where the actuator's `rig:` describes the rig, its mode
+// frequency at mid-stroke (sim::hydraulic_mode_hz) decides too: outside readable_band() the rig
+// is blind whatever the ratio.
 #pragma once
 
 #include <array>
@@ -42,6 +50,21 @@ class ModeVisibilityCheck {
   // level-2 details of an orthonormal wavelet keep white noise's variance.
   static double noise_floor_pa(double sigma, double resolution) noexcept {
     return std::sqrt(sigma * sigma + resolution * resolution / 12.0);
+  }
+
+  // Where a mode still shows in the details of `level`: their band fs/2^(level+1)..fs/2^level
+  // widened to where db8's equivalent filter is 12 dB below its passband (0.74 x the lower and
+  // 1.22 x the upper edge: 46.25 and 152.5 Hz at level 2 and 500 Hz). Measured on simulated rigs
+  // with a 3e-12 leak, three seeds each (docs/tools/mode_band_sweep.py; docs/detection.md, "Other
+  // rigs"), raised within the 90 s after the onset: modes of 48-146 Hz 26/30 (detail_xcorr) and
+  // 29/30 (index_cusum), 44.8 Hz 1/3 each (after 69 and 85 s), 42 Hz and below none; at 154 Hz
+  // the index ratio already calls the rig blind.
+  struct Band {
+    double low, high;
+  };
+  static Band readable_band(double sample_rate_hz, int level) noexcept {
+    const double upper_edge = sample_rate_hz / std::exp2(level);
+    return {0.74 * upper_edge / 2.0, 1.22 * upper_edge};
   }
 
   // One learning hop's index [Pa]; NaN (a gap, an unacquired chamber) is not counted.

@@ -47,6 +47,18 @@ std::string options_text(const std::optional<config::ConfigNode>& node) {
   return one_line(out.c_str());
 }
 
+// The stated keys with their values as read (shortest exact form): a changed value relearns.
+std::string rig_text(const sim::RigDescription& rig) {
+  std::string out;
+  for (const auto& key : rig.stated) {
+    const auto value = sim::rig_value(rig, key);
+    if (!out.empty()) out += " ";
+    out += value ? fmt::format("{}={}", key, *value)
+                 : fmt::format("{}={}/{}", key, rig.oil.nu40(), rig.oil.nu100());
+  }
+  return out;
+}
+
 // Actuator names become file names: keep the safe characters, escape the rest as %XX.
 std::string file_stem(const std::string& actuator) {
   std::string out;
@@ -103,6 +115,9 @@ StateFingerprint state_fingerprint(const ActuatorConfig& actuator, std::int64_t 
                               f.window, f.step, dsp::mode_name(f.mode)));
   fp.parts.emplace_back("detector", kind);
   fp.parts.emplace_back("detector_options", options_text(actuator.detector_options));
+  // The rig sizes what the detector learns (supply, valve, area, oil); a part only when `rig:`
+  // states something, so the paper's rig keeps the fingerprint it had before `rig:` existed.
+  if (!actuator.rig.nominal()) fp.parts.emplace_back("rig", rig_text(actuator.rig));
   fp.parts.emplace_back("period_ns", std::to_string(period_ns));
   std::string all;
   for (const auto& [name, value] : fp.parts) all += name + "=" + value + "\n";

@@ -2,8 +2,8 @@
 // Restart=on-failure) in its state directory (`state.directory`, systemd's StateDirectory=):
 // one file per actuator, so that changing one actuator discards only its own state. A file
 // holds a format version, the fingerprint of the configuration the state depends on (the
-// actuator's channels incl. ps and temp, detector kind and options, feature settings, sample
-// period), the annunciated alarm state, and the detector's state (detect/detector_state.hpp),
+// actuator's channels incl. ps and temp, detector kind and options, its `rig:`, feature
+// settings, sample period), the annunciated alarm state, and the detector's state (detect/detector_state.hpp),
 // closed by a checksum. Files are replaced atomically (temporary file in the same directory,
 // fsync, rename, fsync of the directory): a crash mid-write leaves the previous file whole.
 #pragma once

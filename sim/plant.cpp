@@ -62,6 +62,21 @@ Plant::Plant(const Parameters& params, const Effects& effects, std::uint64_t noi
   reset();
 }
 
+void Plant::set_effects(const Effects& effects) noexcept {
+  effects_ = effects;
+  const double ps0 = c_.ps;
+  c_ = actuator_coefficients(params_, effects);
+  leak_ = effects.internal_leakage
+              ? LeakSchedule{effects.internal_leakage->C_L, effects.internal_leakage->onset_s,
+                             effects.internal_leakage->ramp_s}
+              : LeakSchedule{};
+  external_leak_ = effects.external_leakage ? LeakSchedule{effects.external_leakage->C_E,
+                                                           effects.external_leakage->onset_s,
+                                                           effects.external_leakage->ramp_s}
+                                            : LeakSchedule{};
+  apply_conditions(c_, params_, oil_, temperature_, ps0);
+}
+
 void Plant::set_conditions(double oil_temperature_C, double ps0) noexcept {
   temperature_ = oil_temperature_C;
   apply_conditions(c_, params_, oil_, oil_temperature_C, ps0);

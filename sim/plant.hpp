@@ -79,6 +79,9 @@ class Plant {
   double leak_flow() const;  // q_int at state() and time()
   PlantFlows flows() const;  // every flow at state() and time()
 
+  // Replaces the effects at run time (Scenario::change), the state and the operating
+  // conditions kept; the leaks' schedules restart from the new effects. Allocation-free.
+  void set_effects(const Effects& effects) noexcept;
   // Runtime leak injection (the daemon's sim driver): C_L from onset_s on, ramped over ramp_s.
   void set_internal_leak(double C_L, double onset_s, double ramp_s = 0.0) noexcept;
   // Operating conditions (MODEL.md "Drifting operating conditions"), held until the next call:

@@ -21,6 +21,11 @@ void Reference::draw_level() noexcept {
   level_end_ += hold;
 }
 
+void Reference::start_at(double t0) noexcept {
+  level_ = 0.0;
+  level_end_ = t0;
+}
+
 double Reference::at(double t) noexcept {
   while (t >= level_end_) draw_level();
   return level_;

@@ -20,6 +20,8 @@ class Reference {
   void reset();
   // The level at time t; t must not decrease between calls (until reset()).
   double at(double t) noexcept;
+  // Starts a new level at t0 (a program's steps phase), drawing on from the same stream.
+  void start_at(double t0) noexcept;
 
  private:
   void draw_level() noexcept;

@@ -5,7 +5,8 @@ namespace leakmon::sim {
 Rig::Rig(const Scenario& scenario)
     : scenario_(scenario),
       period_(1.0 / scenario.sample_rate_hz),
-      reference_(scenario.reference, stream_seed(scenario.seed, RandomStream::reference)),
+      reference_(scenario.program, scenario.reference,
+                 stream_seed(scenario.seed, RandomStream::reference), scenario.duration_s),
       controller_(scenario.controller, scenario.sample_rate_hz, scenario.params.u_max),
       plant_(scenario.params, scenario.effects,
              stream_seed(scenario.seed, RandomStream::flow_noise), integration_step(scenario)),
@@ -16,7 +17,18 @@ Rig::Rig(const Scenario& scenario)
   plant_.set_oil(scenario.conditions.oil);
 }
 
+void Rig::use_effects(const Effects& effects) noexcept {
+  plant_.set_effects(effects);
+  sensors_.set_effects(effects);
+  if (scenario_.integration_step_s <= 0.0) {
+    plant_.set_integration_step(
+        automatic_integration_step(scenario_.params, effects, scenario_.sample_rate_hz));
+  }
+}
+
 void Rig::reset() {
+  if (changed_) use_effects(scenario_.effects);
+  changed_ = false;
   reference_.reset();
   controller_.reset();
   plant_.reset();
@@ -33,6 +45,11 @@ RigSample Rig::step() noexcept {
   // MODEL.md "Simulation conventions": measure, compute u from the measured position, record,
   // then integrate the next sample with u held.
   const double t = static_cast<double>(index_) * period_;
+  // Effects that appear inside the run: from the first sample at or after their time on.
+  if (scenario_.change && !changed_ && t >= scenario_.change->t_s) {
+    use_effects(scenario_.change->effects);
+    changed_ = true;
+  }
   // Conditions drift slowly: read at the sample's time, held over the sample.
   const OperatingConditions& conditions = scenario_.conditions;
   if (conditions.any()) {

@@ -8,7 +8,7 @@
 
 #include "sim/controller.hpp"
 #include "sim/plant.hpp"
-#include "sim/reference.hpp"
+#include "sim/program.hpp"
 #include "sim/scenario.hpp"
 #include "sim/sensor_faults.hpp"
 #include "sim/sensors.hpp"
@@ -17,7 +17,7 @@ namespace leakmon::sim {
 
 struct RigSample {
   double t;          // s
-  double xref;       // m
+  double xref;       // m (the program's reference, before the controller's prefilter)
   double u;          // V, as commanded (before valve_bias)
   double x, p1, p2;  // recorded (sensor chain and any sensor fault applied)
   double ps, temp;   // recorded supply pressure [Pa] and oil temperature [degC]
@@ -43,14 +43,18 @@ class Rig {
   const Plant& plant() const { return plant_; }
 
  private:
+  // The plant's and transducers' effects, with the integration step they need.
+  void use_effects(const Effects& effects) noexcept;
+
   Scenario scenario_;
   double period_;
-  Reference reference_;
+  ProgramReference reference_;
   Controller controller_;
   Plant plant_;
   Sensors sensors_;
   SensorFaults faults_;
   std::uint64_t index_ = 0;
+  bool changed_ = false;  // Scenario::change applied
 };
 
 }  // namespace leakmon::sim

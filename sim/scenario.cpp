@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "capture/units.hpp"
@@ -27,9 +28,10 @@ struct EffectSpec {
 
 const std::vector<EffectSpec>& effect_specs() {
   static const std::vector<EffectSpec> specs = {
-      {"internal_leakage", {{"C_L", 0.0, 1e-9}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
+      // ramp_s: from a needle valve opened by hand (a second) to a seal that wears (hours).
+      {"internal_leakage", {{"C_L", 0.0, 1e-9}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e6}}},
       {"external_leakage",
-       {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e4}}},
+       {{"C_E", 0.0, 1e-9}, {"chamber", 1.0, 2.0}, {"onset_s", 0.0, 1e7}, {"ramp_s", 0.0, 1e6}}},
       {"coulomb_friction", {{"F_C", 0.0, 1e4}}},
       {"entrained_air", {{"alpha", 0.0, 1.0}}},
       {"valve_overlap", {{"d", 0.0, 0.5}}},
@@ -84,9 +86,14 @@ std::vector<std::string> spec_names(const Specs& specs) {
   return names;
 }
 
-void read_parameters(const config::ConfigNode& node, Parameters& params) {
+void read_parameters(const config::ConfigNode& node, const RigDescription& rig,
+                     Parameters& params) {
   node.expect_keys(spec_names(parameter_specs()));
   for (const auto& spec : parameter_specs()) {
+    if (rig.states_symbol(spec.name) && node.has(spec.name)) {
+      node.at(spec.name).fail(fmt::format(
+          "{} is also stated in the scenario's rig: ({}); give it once", spec.name, rig.source));
+    }
     double& value = parameter(params, spec.name);
     value = node.get_double(spec.name, value, spec.lo, spec.hi);
   }
@@ -129,6 +136,71 @@ void read_reference(const config::ConfigNode& node, ReferenceSettings& reference
   reference.hold_max = node.get_double("hold_max", reference.hold_max, 1e-3, 1e5);
   if (reference.amp_max < reference.amp_min) node.fail("amp_max must not be below amp_min");
   if (reference.hold_max < reference.hold_min) node.fail("hold_max must not be below hold_min");
+}
+
+// MODEL.md "Test programs": `- {phase: sine, F: 0.5, A: 0.02, duration_s: 240}`, the values
+// named by MODEL.md's symbols; every phase but the last needs its length.
+std::vector<Phase> read_program(const config::ConfigNode& node, const Parameters& params) {
+  if (!node.is_sequence() || node.items().empty()) {
+    node.fail(
+        "must be a list of phases {phase: steps|hold|sine|sweep|triangle, their values, "
+        "duration_s}");
+  }
+  const double half_stroke = 0.5 * params.L;
+  const auto inside_stroke = [&](const config::ConfigNode& item, std::string_view key,
+                                 double value) {
+    if (std::abs(value) >= half_stroke) {
+      item.at(key).fail(fmt::format("{} must stay inside the stroke (|{}| < L/2 = {:g} m)", key,
+                                    key, half_stroke));
+    }
+  };
+  std::vector<Phase> program;
+  const auto items = node.items();
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const config::ConfigNode& item = items[i];
+    if (!item.is_map()) item.fail("a phase is a mapping {phase: KIND, its values, duration_s}");
+    if (!item.has("phase")) item.fail("phase is required (steps, hold, sine, sweep or triangle)");
+    Phase phase;
+    phase.kind = *phase_kind_from_string(
+        item.get_choice("phase", {"steps", "hold", "sine", "sweep", "triangle"}, "steps"));
+    switch (phase.kind) {
+      case PhaseKind::steps:
+        item.expect_keys({"phase", "duration_s"});
+        break;
+      case PhaseKind::hold:
+        item.expect_keys({"phase", "X", "duration_s"});
+        phase.X = item.get_double("X", -10.0, 10.0);
+        inside_stroke(item, "X", phase.X);
+        break;
+      case PhaseKind::sine:
+        item.expect_keys({"phase", "F", "A", "duration_s"});
+        phase.F = item.get_double("F", 1e-4, 100.0);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+      case PhaseKind::sweep:
+        item.expect_keys({"phase", "F0", "F1", "A", "duration_s"});
+        phase.F0 = item.get_double("F0", 0.0, 100.0);
+        phase.F1 = item.get_double("F1", 0.0, 100.0);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+      case PhaseKind::triangle:
+        item.expect_keys({"phase", "P", "A", "duration_s"});
+        phase.P = item.get_double("P", 1e-3, 1e5);
+        phase.A = item.get_double("A", 0.0, 10.0);
+        break;
+    }
+    if (phase.kind != PhaseKind::steps && phase.kind != PhaseKind::hold) {
+      inside_stroke(item, "A", phase.A);
+    }
+    const bool last = i + 1 == items.size();
+    if (!last && !item.has("duration_s")) {
+      item.fail("duration_s is required for every phase but the last (which runs to the end)");
+    }
+    // A sweep needs its T; the last phase's defaults to the rest of the run.
+    phase.duration_s = item.has("duration_s") ? item.get_double("duration_s", 0.002, 1e7) : 0.0;
+    program.push_back(phase);
+  }
+  return program;
 }
 
 void read_sensors(const config::ConfigNode& node, SensorSettings& sensors) {
@@ -225,9 +297,16 @@ std::vector<SupplyChange> read_supply(const config::ConfigNode& node) {
   return changes;
 }
 
-void read_conditions(const config::ConfigNode& node, OperatingConditions& conditions) {
+void read_conditions(const config::ConfigNode& node, const RigDescription& rig,
+                     OperatingConditions& conditions) {
   node.expect_keys({"oil", "temperature", "supply"});
-  if (auto oil = node.find("oil")) conditions.oil = read_oil(*oil);
+  if (auto oil = node.find("oil")) {
+    if (rig.states_symbol("oil")) {
+      oil->fail(fmt::format("the oil is also stated in the scenario's rig: ({}); give it once",
+                            rig.source));
+    }
+    conditions.oil = read_oil(*oil);
+  }
   if (auto temperature = node.find("temperature")) {
     conditions.temperature = read_temperature(*temperature);
   }
@@ -300,10 +379,47 @@ std::vector<SensorFault> read_faults(const config::ConfigNode& node,
   return faults;
 }
 
+// The reference against what the rig can do (reference_reach): an error beyond the end stops
+// or nearly all of the rig's force, a warning where tracking suffers. Reported at the
+// reference's amp_max when given, else at the rig (or params) that makes it too much.
+void check_reach(const config::ConfigNode& root, Scenario& scenario) {
+  const ReferenceReach reach = reference_reach(scenario.params, scenario.reference);
+  std::optional<config::ConfigNode> at;
+  if (auto reference = root.find("reference")) at = reference->find("amp_max");
+  if (!at) at = root.find("rig");
+  if (!at) at = root.find("params");
+  if (!at) at = root;
+  const double amplitude_mm = scenario.reference.amp_max * 1e3;
+  const std::string stroke =
+      fmt::format("the reference's steps reach {:.4g} mm, {:.0f} % of the half stroke ({:.4g} mm)",
+                  amplitude_mm, 100.0 * reach.stroke_share, scenario.params.L * 500.0);
+  const std::string force = fmt::format(
+      "the load spring needs {:.4g} kN at the reference's largest step ({:.4g} mm), {:.0f} % of "
+      "the {:.4g} kN the piston can make (A (ps - pt))",
+      scenario.params.K_s * scenario.reference.amp_max * 1e-3, amplitude_mm,
+      100.0 * reach.force_share,
+      scenario.params.A() * (scenario.params.ps - scenario.params.pt) * 1e-3);
+  if (reach.stroke_share >= kStrokeShareError) {
+    at->fail(stroke + ": beyond the end stops; lower reference.amp_max or state the stroke");
+  }
+  if (reach.force_share > kForceShareError) {
+    at->fail(force + ": the rig cannot follow it; lower reference.amp_max");
+  }
+  if (reach.stroke_share > kStrokeShareWarning) {
+    scenario.warnings.push_back(
+        fmt::format("{}: {}: overshoot may hit the end stops", at->location(), stroke));
+  }
+  if (reach.force_share > kForceShareWarning) {
+    scenario.warnings.push_back(fmt::format(
+        "{}: {}: above about half the rig tracks the steps poorly (MODEL.md \"Other rigs\")",
+        at->location(), force));
+  }
+}
+
 Scenario read_scenario(const config::ConfigNode& root) {
   root.expect_keys({"name", "controller", "duration_s", "seed", "sample_rate_hz",
-                    "integration_step_s", "reference", "params", "effects", "sensors", "conditions",
-                    "faults", "record"});
+                    "integration_step_s", "reference", "program", "rig", "params", "effects",
+                    "sensors", "conditions", "faults", "record"});
   Scenario scenario;
   scenario.name = root.get_string("name", "scenario");
   scenario.controller = controller_kind_from_string(
@@ -312,10 +428,24 @@ Scenario read_scenario(const config::ConfigNode& root) {
   scenario.seed = static_cast<std::uint64_t>(root.get_int("seed", 1, 0, (1LL << 62)));
   scenario.sample_rate_hz = root.get_double("sample_rate_hz", 500.0, 50.0, 1e5);
   if (auto node = root.find("reference")) read_reference(*node, scenario.reference);
-  if (auto node = root.find("params")) read_parameters(*node, scenario.params);
+  if (auto node = root.find("rig")) {
+    scenario.rig = read_rig(*node);
+    scenario.params = scenario.rig.params;
+    scenario.conditions.oil = scenario.rig.oil;
+    // The transducers a rig with this supply is fitted with, unless `sensors:` says otherwise
+    // (the paper's 20.7 MPa for its 17.2 MPa).
+    if (scenario.rig.states("supply_pressure")) {
+      scenario.sensors.pressure_full_scale = sensors_for(scenario.rig.params).pressure_full_scale;
+    }
+  }
+  if (auto node = root.find("params")) read_parameters(*node, scenario.rig, scenario.params);
+  if (auto node = root.find("program")) scenario.program = read_program(*node, scenario.params);
   if (auto node = root.find("effects")) read_effects(*node, scenario.effects);
   if (auto node = root.find("sensors")) read_sensors(*node, scenario.sensors);
-  if (auto node = root.find("conditions")) read_conditions(*node, scenario.conditions);
+  check_reach(root, scenario);
+  if (auto node = root.find("conditions")) {
+    read_conditions(*node, scenario.rig, scenario.conditions);
+  }
   if (auto node = root.find("record")) scenario.record = read_record(*node);
   if (auto node = root.find("faults")) scenario.faults = read_faults(*node, scenario.record);
   if (auto node = root.find("integration_step_s")) {
@@ -346,6 +476,13 @@ Scenario paper_experiment(std::string_view name, ControllerKind controller, doub
 }
 
 }  // namespace
+
+ReferenceReach reference_reach(const Parameters& params, const ReferenceSettings& reference) {
+  ReferenceReach reach;
+  reach.stroke_share = reference.amp_max / (0.5 * params.L);
+  reach.force_share = params.K_s * reference.amp_max / (params.A() * (params.ps - params.pt));
+  return reach;
+}
 
 std::uint64_t Scenario::samples() const {
   return static_cast<std::uint64_t>(std::llround(duration_s * sample_rate_hz));

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "sim/effects.hpp"
+#include "sim/parameters.hpp"
 #include "sim/random.hpp"
 
 namespace leakmon::sim {
@@ -29,6 +30,10 @@ struct SensorSettings {
   double pressure_lsb() const;
 };
 
+// MODEL.md's transducer chain ranged for the supply: the smallest of the usual ranges (10, 20.7,
+// 25, 35, 40, 60 MPa) that reads 1.15 x the supply; the paper's 20.7 MPa on the paper's rig.
+SensorSettings sensors_for(const Parameters& params);
+
 // The quantisers of the chain (also used to re-quantise a spiked reading).
 double quantise_pressure(const SensorSettings& s, double p) noexcept;  // clamped to the range
 double quantise_position(const SensorSettings& s, double x) noexcept;
@@ -43,6 +48,8 @@ class Sensors {
  public:
   Sensors(const SensorSettings& settings, const Effects& effects, std::uint64_t seed);
   void reset();
+  // The transducer offsets of `effects` from now on (Scenario::change).
+  void set_effects(const Effects& effects) noexcept;
   // p1_transducer, p2_transducer: the pressures after any transducer lag (plant states).
   Measurement measure(double x, double p1_transducer, double p2_transducer) noexcept;
   // The optional transducers (supply pressure: the pressure chain; oil temperature: the RTD),

@@ -75,6 +75,23 @@ std::string overridden_parameters(const Parameters& p) {
   return out;
 }
 
+// "hold 0.02 for 180 s; steps for 300 s; ...; triangle 4 0.03 to the end".
+std::string program_description(const std::vector<Phase>& program) {
+  std::string out;
+  for (std::size_t i = 0; i < program.size(); ++i) {
+    if (i > 0) out += "; ";
+    out += program[i].notation();
+    if (i + 1 < program.size()) {
+      out += fmt::format(" for {:.10g} s", program[i].duration_s);
+    } else if (program[i].duration_s > 0.0) {
+      out += fmt::format(" (T {:.10g} s) to the end", program[i].duration_s);
+    } else {
+      out += " to the end";
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 capture::Metadata capture_metadata(const Scenario& scenario) {
@@ -94,6 +111,18 @@ capture::Metadata capture_metadata(const Scenario& scenario) {
   for (const auto& effect : effects) {
     meta.emplace_back("effect", fmt::format("{} {}", effect.name, format_params(effect.params)));
   }
+  if (scenario.change) {
+    std::string appearing;
+    for (const auto& effect : scenario.change->effects.describe()) {
+      appearing += fmt::format("{}{} {}", appearing.empty() ? "" : "; ", effect.name,
+                               format_params(effect.params));
+    }
+    meta.emplace_back("effect_change",
+                      fmt::format("t_s={:g} effects {}", scenario.change->t_s,
+                                  appearing.empty() ? std::string("none") : appearing));
+  }
+  // Listed only for another rig, so that the paper's captures read as before.
+  if (!scenario.rig.nominal()) meta.emplace_back("rig", describe(scenario.rig));
   const std::string overrides = overridden_parameters(scenario.params);
   meta.emplace_back("params", overrides.empty() ? "nominal" : overrides);
   const SensorSettings& s = scenario.sensors;
@@ -107,8 +136,18 @@ capture::Metadata capture_metadata(const Scenario& scenario) {
                         s.position_resolution, s.position_quantisation ? "" : " (unquantised)",
                         s.position_noise_sigma)
           : std::string("ideal (true values)"));
-  // Drifting conditions, faults and optional transducers: listed only when present, so that a
-  // stationary scenario's metadata reads as before.
+  // A test program, drifting conditions, faults and optional transducers: listed only when
+  // present, so that a stationary scenario on the paper's steps reads as before.
+  if (!scenario.program.empty()) {
+    meta.emplace_back("program", program_description(scenario.program));
+    // One line per phase with where it sits in this run, for scoring per phase.
+    const auto spans = phase_spans(scenario.program, scenario.duration_s);
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+      meta.emplace_back(
+          "phase", fmt::format("{} start_s={:.10g} end_s={:.10g}", scenario.program[i].notation(),
+                               spans[i].start, spans[i].end));
+    }
+  }
   const OperatingConditions& c = scenario.conditions;
   if (c.temperature) {
     meta.emplace_back("oil", fmt::format("{}nu40={:g} nu100={:g} (Walther, ASTM D341)",

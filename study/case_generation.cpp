@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
+
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::study {
 namespace {
@@ -66,12 +69,141 @@ void draw_sensor_fault(std::mt19937_64& rng, int kind, double from, double to, R
   run.scenario.faults.push_back(fault);
 }
 
+// MODEL.md "Test programs": a phase of `kind` with the table's typical values and length (times
+// `time_scale`), each drawn uniformly in its range.
+sim::Phase draw_phase(std::mt19937_64& rng, sim::PhaseKind kind, double time_scale) {
+  sim::Phase phase;
+  phase.kind = kind;
+  double minutes_lo = 2.0, minutes_hi = 10.0;
+  switch (kind) {
+    case sim::PhaseKind::steps:
+      break;
+    case sim::PhaseKind::hold:
+      phase.X = uniform(rng, -0.05, 0.05);
+      minutes_lo = 1.0;
+      break;
+    case sim::PhaseKind::sine:
+      phase.F = uniform(rng, 0.2, 3.0);
+      phase.A = uniform(rng, 0.005, 0.04);
+      break;
+    case sim::PhaseKind::sweep:
+      phase.F0 = uniform(rng, 0.1, 0.5);
+      phase.F1 = uniform(rng, 1.5, 4.0);
+      phase.A = uniform(rng, 0.005, 0.03);
+      minutes_lo = 1.0;
+      minutes_hi = 5.0;
+      break;
+    case sim::PhaseKind::triangle:
+      phase.P = uniform(rng, 1.0, 8.0);
+      phase.A = uniform(rng, 0.01, 0.045);
+      break;
+  }
+  phase.duration_s = 60.0 * uniform(rng, minutes_lo, minutes_hi) * time_scale;
+  return phase;
+}
+
+// 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
+// the others with another kind. With `leak_kind` one phase after the first and before the last
+// (learning happens in the first; a leak in a hold is judged in the next) takes that kind; its
+// index goes to `leak_phase`.
+std::vector<sim::Phase> draw_program(std::mt19937_64& rng, double time_scale,
+                                     std::optional<sim::PhaseKind> leak_kind, int& leak_phase) {
+  auto any_kind = [&] {
+    return sim::kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
+  };
+  const int n = std::uniform_int_distribution<int>(3, 8)(rng);
+  std::vector<sim::PhaseKind> kinds;
+  for (int i = 0; i < n; ++i) kinds.push_back(any_kind());
+  const sim::PhaseKind not_hold[] = {sim::PhaseKind::steps, sim::PhaseKind::sine,
+                                     sim::PhaseKind::sweep, sim::PhaseKind::triangle};
+  kinds[0] = rng() % 2 == 0 ? sim::PhaseKind::hold
+                            : not_hold[std::uniform_int_distribution<int>(0, 3)(rng)];
+  leak_phase = -1;
+  if (leak_kind) {
+    leak_phase = std::uniform_int_distribution<int>(1, n - 2)(rng);
+    kinds[static_cast<std::size_t>(leak_phase)] = *leak_kind;
+  }
+  std::vector<sim::Phase> program;
+  for (const sim::PhaseKind kind : kinds) program.push_back(draw_phase(rng, kind, time_scale));
+  return program;
+}
+
+double program_seconds(const std::vector<sim::Phase>& program) {
+  double total = 0.0;
+  for (const sim::Phase& phase : program) total += phase.duration_s;
+  return total;
+}
+
+// Whether a leak in `phase` can be seen: not in a hold whose load |K_s X| / A stays below
+// kJudgeableLoad.
+bool judgeable(const sim::Phase& phase, const sim::Parameters& params) {
+  return phase.kind != sim::PhaseKind::hold ||
+         std::abs(params.K_s * phase.X) / params.A() >= kJudgeableLoad;
+}
+
+// The truth of a program run: its phases where they sit in the run.
+void describe_program(RunSpec& run) {
+  const sim::Scenario& s = run.scenario;
+  const auto spans = sim::phase_spans(s.program, s.duration_s);
+  run.phases.clear();
+  for (std::size_t i = 0; i < spans.size(); ++i) {
+    const sim::Phase& phase = s.program[i];
+    run.phases.push_back(
+        {phase.kind, spans[i].start, spans[i].end, judgeable(phase, s.params), phase.notation()});
+  }
+}
+
+// programs: a random program on the stationary rig. A healthy run lasts as long as its program;
+// a leak run opens its leak inside the phase of the planned kind, 20 s or more after learning,
+// in the phase's first part (detect_within before its end where the phase is that long), and
+// runs on for the condition's time after the onset, or to detect_within + 30 s after the phase's
+// end when the phase cannot be judged.
+void apply_program(std::mt19937_64& rng, const EvaluationOptions& options, RunSpec& run) {
+  sim::Scenario& s = run.scenario;
+  const auto* leak = std::get_if<LeakCondition>(&run.condition.kind);
+  std::optional<sim::PhaseKind> leak_kind;
+  if (leak && run.leak > 0.0) {
+    leak_kind = leak->phase
+                    ? *leak->phase
+                    : sim::kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
+  }
+  int j = -1;
+  s.program = draw_program(rng, options.time_scale, leak_kind, j);
+  s.duration_s = program_seconds(s.program);
+  if (j >= 0) {
+    const auto at = static_cast<std::size_t>(j);
+    auto spans = sim::phase_spans(s.program, program_seconds(s.program));
+    const double length = spans[at].end - spans[at].start;
+    const double lo =
+        std::max(spans[at].start + std::min(10.0, 0.1 * length), run.monitor_from + 20.0);
+    if (lo > spans[at].end - 10.0) {
+      // A short phase right after learning: lengthened so the leak opens inside it.
+      s.program[at].duration_s += lo - (spans[at].end - 10.0);
+      spans = sim::phase_spans(s.program, program_seconds(s.program));
+    }
+    const double hi = std::max(lo, spans[at].end - options.detect_within);
+    run.onset = uniform(rng, lo, hi);
+    run.leak_phase = j;
+    double end = run.onset + leak->after_onset_seconds;
+    if (!judgeable(s.program[at], s.params)) {
+      end = std::max(end, spans[at].end + options.detect_within + 30.0);
+    }
+    s.duration_s = end;
+    s.effects.internal_leakage->onset_s = run.onset;
+  }
+  describe_program(run);
+}
+
 // Draws the operating condition's parameters onto the scenario (MODEL.md "Drifting operating
 // conditions" and "Sensor faults"), from its own stream so the rig draws of the other runs stay
 // as they are. `healthy_from`..`healthy_to` is where a sensor fault may sit.
 void apply_operating(const std::string& operating, std::mt19937_64& rng, double healthy_from,
                      double healthy_to, const EvaluationOptions& options, RunSpec& run) {
   if (operating == "stationary") return;
+  if (operating == "programs") {
+    apply_program(rng, options, run);
+    return;
+  }
   sim::Scenario& s = run.scenario;
   s.record.temp = true;
   s.record.ps = true;
@@ -91,7 +223,7 @@ void apply_operating(const std::string& operating, std::mt19937_64& rng, double 
       s.duration_s = run.onset + after;
       s.effects.internal_leakage->onset_s = run.onset;
     }
-  } else if (operating == "cooler") {
+  } else if (operating == "cooler" || operating == "wear") {
     profile.kind = sim::TemperatureProfile::Kind::cooler;
     profile.T_work = uniform(rng, 45.0, 55.0);
     profile.amplitude = uniform(rng, 1.0, 4.0);
@@ -99,6 +231,16 @@ void apply_operating(const std::string& operating, std::mt19937_64& rng, double 
     // The cycle's phase at the start of learning is random too.
     profile.cooler_start_s = -uniform(rng, 0.0, profile.period_s);
     s.conditions.temperature = profile;
+    if (operating == "wear" && run.leak > 0.0) {
+      // A seal that wears (MODEL.md "Test programs"): C_L from 0 at the onset to 1e-12..5e-12
+      // over 10 min to 4 h (log-uniform), the run going on after it for the condition's time.
+      run.leak = uniform(rng, 1e-12, 5e-12);
+      run.wear_seconds =
+          std::exp(uniform(rng, std::log(600.0), std::log(14400.0))) * options.time_scale;
+      const double after = s.duration_s - run.onset;
+      s.effects.internal_leakage = sim::InternalLeakage{run.leak, run.onset, run.wear_seconds};
+      s.duration_s = run.onset + run.wear_seconds + after;
+    }
   } else if (operating == "supply") {
     const int changes = std::uniform_int_distribution<int>(1, 2)(rng);
     double t = healthy_from;
@@ -162,9 +304,14 @@ std::vector<Condition> plan_conditions(const EvaluationOptions& options) {
   for (int i = 0; i < options.healthy_runs; ++i) {
     plan.push_back({HealthyCondition{options.healthy_seconds}, options.effects, pick(i)});
   }
+  std::size_t program_leaks = 0;  // leak runs under `programs`: the phase kinds in turn
   for (double leak : options.leak_sizes) {
     for (int i = 0; i < options.runs_per_leak; ++i) {
-      plan.push_back({LeakCondition{leak, options.after_onset_seconds}, options.effects, pick(i)});
+      LeakCondition condition{leak, options.after_onset_seconds, std::nullopt};
+      if (pick(i) == "programs") {
+        condition.phase = sim::kPhaseKinds[program_leaks++ % sim::kPhaseKinds.size()];
+      }
+      plan.push_back({condition, options.effects, pick(i)});
     }
   }
   for (int i = 0; i < options.sensor_fault_runs; ++i) {
@@ -175,8 +322,49 @@ std::vector<Condition> plan_conditions(const EvaluationOptions& options) {
   return plan;
 }
 
+double RunSpec::leak_at(double t) const {
+  if (leak <= 0.0 || t < onset) return 0.0;
+  if (!wear_run() || wear_seconds <= 0.0) return leak;
+  return leak * std::min(1.0, (t - onset) / wear_seconds);
+}
+
+int RunSpec::phase_at(double t) const {
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    if (t >= phases[i].start && t < phases[i].end) return static_cast<int>(i);
+  }
+  // The run's last instant belongs to the last phase reached.
+  for (std::size_t i = phases.size(); i-- > 0;) {
+    if (phases[i].start < phases[i].end) return t == phases[i].end ? static_cast<int>(i) : -1;
+  }
+  return -1;
+}
+
+double RunSpec::detection_deadline(double detect_within) const {
+  const int i = phase_at(onset);
+  if (i < 0 || phases[static_cast<std::size_t>(i)].judgeable) return onset + detect_within;
+  return phases[static_cast<std::size_t>(i)].end + detect_within;
+}
+
 std::uint64_t simulation_seed(std::uint64_t seed, int id) {
   return seed * 100003 + static_cast<std::uint64_t>(id);
+}
+
+// Seeds the rig drawer apart from the simulation's own streams.
+constexpr std::uint64_t kOtherRigSeed = 0x6f746865722d7267ULL;  // "other-rg"
+
+void use_other_rig(RunSpec& run) {
+  sim::Scenario& s = run.scenario;
+  const sim::OtherRig other = sim::draw_other_rig(s.seed ^ kOtherRigSeed, s.controller);
+  s.rig = other.rig;
+  s.params = other.rig.params;
+  s.conditions.oil = other.rig.oil;
+  s.reference = other.reference;
+  s.sensors = other.sensors;
+  s.name += "-other-rig";
+  if (run.leak > 0.0) {
+    run.leak *= s.params.Kv / kPaperValveCoefficient;
+    if (s.effects.internal_leakage) s.effects.internal_leakage->C_L = run.leak;
+  }
 }
 
 RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
@@ -205,6 +393,7 @@ RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,
                  },
              },
              condition.kind);
+  if (options.rigs == "other") use_other_rig(run);
   std::mt19937_64 operating_draws(seed ^ 0x6a09e667f3bcc909ULL);
   run.sensor_fault_run = std::holds_alternative<SensorFaultCondition>(condition.kind);
   apply_operating(condition.operating, operating_draws, run.monitor_from,

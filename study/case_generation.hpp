@@ -24,10 +24,12 @@ struct HealthyCondition {
 };
 
 // A healthy stretch after learning, then an internal leak of C_L `coefficient` [m^3/(s Pa)]
-// switched on for `after_onset_seconds`.
+// switched on for `after_onset_seconds`. Under the `programs` condition the leak opens inside a
+// phase of kind `phase` (the plan cycles through the kinds).
 struct LeakCondition {
   double coefficient = 0.0;
   double after_onset_seconds = 0.0;
+  std::optional<sim::PhaseKind> phase = std::nullopt;
 };
 
 // A sensor fault of one transducer (its kind drawn) after learning; with `coefficient` > 0 an
@@ -45,6 +47,20 @@ struct Condition {
   Kind kind;
   std::vector<std::string> effects;      // MODEL.md effects on from the start (default parameters)
   std::string operating = "stationary";  // one of kConditionNames: how the rig drifts
+};
+
+// Below this load |K_s X| / A a hold gives nothing to judge: the leak's flow C_L (p1 - p2)
+// vanishes with p1 - p2 (MODEL.md "Test programs": about 1 MPa on this rig).
+inline constexpr double kJudgeableLoad = 1e6;  // Pa
+
+// A phase of a run's test program where it sits in the run, as the truth scores it.
+struct ProgramPhase {
+  sim::PhaseKind kind = sim::PhaseKind::steps;
+  double start = 0.0, end = 0.0;  // [s]; the last phase reached ends with the run
+  // False for a hold whose load |K_s X| / A stays below kJudgeableLoad: a leak opening there is
+  // to be found within the window of the next phase's start instead.
+  bool judgeable = true;
+  std::string notation;  // "hold 0.02", "sine 0.5 0.02", ... (sim::Phase::notation)
 };
 
 // One run to simulate and the truth to score it against.
@@ -73,17 +89,42 @@ struct RunSpec {
   std::optional<sim::Scenario> after_restart;
   double stop_at = NAN, restart_at = NAN, downtime = NAN;
   double temp_before = NAN, temp_after = NAN;  // oil temperature [degC] before and after
+  // programs: the phases of the run's test program (scenario.program) where they sit in the run
+  // (empty: the paper's steps), and the one the leak opens in (-1: none).
+  std::vector<ProgramPhase> phases;
+  int leak_phase = -1;
+  // wear: C_L grows linearly from 0 at `onset` to `leak` over `wear_seconds` (NaN: a leak that
+  // opens at once). Scored by the C_L at which it is found (write_condition_summaries), not in
+  // the generic tables.
+  double wear_seconds = NAN;
+  bool wear_run() const { return !std::isnan(wear_seconds); }
+  // The C_L [m^3/(s Pa)] in force at t.
+  double leak_at(double t) const;
+  // Index into `phases` of the phase that holds t (-1 without a program or outside it).
+  int phase_at(double t) const;
+  // The latest raise that finds the leak: detect_within after the onset, or after the next
+  // phase's start when the leak opens in a phase that cannot be judged.
+  double detection_deadline(double detect_within) const;
 };
 
 // The evaluation's conditions in run order: healthy_runs healthy runs, then runs_per_leak leak
 // runs per leak size, each with the options' effects, then sensor_fault_runs SensorFaultCondition
 // runs: the kinds in turn, each kind's runs alternately without and with a leak of
-// kSensorFaultLeak opening during the fault.
+// kSensorFaultLeak opening during the fault. Leak runs under `programs` take the phase kinds in
+// turn (steps, hold, sine, sweep, triangle) for the phase their leak opens in.
 inline constexpr double kSensorFaultLeak = 1e-12;
 std::vector<Condition> plan_conditions(const EvaluationOptions& options);
 
 // Seed of run `id`'s simulation (noise, reference) in a study with master seed `seed`.
 std::uint64_t simulation_seed(std::uint64_t seed, int id);
+
+// MODEL.md's Kv of the paper's valve: leak sizes on other rigs are stated relative to it.
+inline constexpr double kPaperValveCoefficient = 3.39e-7;
+
+// The case generator's hook for `--rigs other`: the run's rig (description, plant, oil,
+// reference, transducers) becomes one drawn by sim::draw_other_rig for the run's controller,
+// seeded by the run's seed; its leak (and onset, duration, effects) stays, scaled to the valve.
+void use_other_rig(RunSpec& run);
 
 // The scenario of run `id` under `condition`. The rig (controller, spring, beta, Kv, m, b,
 // reference amplitude) and the onset are drawn from `rig_draws`, the study's one stream shared

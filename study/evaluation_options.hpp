@@ -33,6 +33,12 @@ struct EvaluationOptions {
   double after_fault_seconds = 90.0;
   // restart: how long the daemon watches a healthy rig after restarting.
   double after_restart_seconds = 300.0;
+  // programs and wear: phase lengths and wear durations are MODEL.md's typical values times this
+  // (1; smaller for a quick check).
+  double time_scale = 1.0;
+  // "paper": rigs across MODEL.md's calibration spread of the paper's rig; "other": each run on
+  // a rig drawn by sim::draw_other_rig, leaks scaled to its valve (study/rig_cases.hpp).
+  std::string rigs = "paper";
   std::vector<int> keep_captures;  // run ids whose capture CSV is written into `out`
   std::filesystem::path out;
 };
@@ -58,9 +64,14 @@ std::vector<Candidate> candidates();
 // of one transducer: frozen, saturated, spikes or dropout, 10-60 s), restart (the daemon stopped
 // after learning and restarted from its saved state after a downtime of 10 s-30 min in which
 // the oil warmed or cooled by 1-5 K and, in leak runs, the leak opened), each with an oil grade
-// VG 32, 46 or 68.
-inline constexpr std::string_view kConditionNames[] = {"stationary", "warmup",        "cooler",
-                                                       "supply",     "sensor-faults", "restart"};
+// VG 32, 46 or 68; programs (MODEL.md "Test programs": 3-8 phases of steps, hold, sine, sweep
+// and triangle with its typical values and lengths, half of them starting with a hold; healthy
+// runs last as long as their program, leak runs open their leak inside a phase of a given kind;
+// the stationary rig) and wear (C_L growing linearly from 0 to 1e-12..5e-12 over 10 min to 4 h
+// on the paper's steps, the oil cycling with the cooler as under `cooler`; healthy runs: the
+// same rig without wear).
+inline constexpr std::string_view kConditionNames[] = {
+    "stationary", "warmup", "cooler", "supply", "sensor-faults", "restart", "programs", "wear"};
 bool is_condition(std::string_view name);
 
 // Position of the design threshold in `raise_thresholds` (its size when absent).

@@ -170,7 +170,7 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
   if (!spec.after_restart) {
     collect_alarms(pipeline::replay_capture(capture, evaluation_config(capture, options)), 0.0,
                    result);
-    if (spec.leak > 0.0) {
+    if (spec.leak > 0.0 && !spec.wear_run()) {
       result.size_check = check_size(capture, spec, options, detector_options(options));
     }
     result.seconds = spec.scenario.duration_s;

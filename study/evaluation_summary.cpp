@@ -127,7 +127,8 @@ Rates rates_of(const std::vector<RunResult>& results, std::size_t candidate, std
   Rates rates;
   for (const auto& r : results) {
     if (!in_group(r, controller) || r.spec.sensor_fault_run) continue;
-    const bool leak_match = leak == 0.0 || r.spec.leak == leak;
+    // A seal that wears is scored by the size it is found at (score_wear), not within a window.
+    const bool leak_match = (leak == 0.0 || r.spec.leak == leak) && !r.spec.wear_run();
     add_run(rates, r, candidate, threshold, detect_within, true, leak_match);
   }
   return rates;
@@ -142,7 +143,7 @@ Coverage coverage_of(const std::vector<RunResult>& results, std::string_view con
   Coverage coverage;
   for (const auto& r : results) {
     if (r.spec.leak != leak || std::isnan(r.size_check.leak_coefficient)) continue;
-    if (r.spec.sensor_fault_run) continue;
+    if (r.spec.sensor_fault_run || r.spec.wear_run()) continue;
     if (!in_group(r, controller)) continue;
     ++coverage.raised;
     coverage.covered += r.size_check.covers(leak) ? 1 : 0;
@@ -270,6 +271,116 @@ RestartScore score_restarts(const std::vector<RunResult>& results, std::size_t c
   }
   std::sort(score.delays.begin(), score.delays.end());
   return score;
+}
+
+double PhaseKindScore::false_alarms_per_hour() const {
+  return healthy_hours > 0 ? false_alarms / healthy_hours : NAN;
+}
+
+double PhaseKindScore::false_alarms_per_hour_upper_95() const {
+  return healthy_hours > 0 ? poisson_upper_95(false_alarms) / healthy_hours : NAN;
+}
+
+std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& results,
+                                                 std::size_t candidate, double detect_within) {
+  // Rows: the five kinds with the holds that cannot be judged after the holds.
+  std::vector<PhaseKindScore> rows;
+  for (const sim::PhaseKind kind : sim::kPhaseKinds) {
+    rows.push_back({.phase = std::string(sim::to_string(kind))});
+    if (kind == sim::PhaseKind::hold) rows.push_back({.phase = "hold (not judgeable)"});
+  }
+  auto row_of = [&](const ProgramPhase& phase) -> PhaseKindScore& {
+    const std::string name = phase.kind == sim::PhaseKind::hold && !phase.judgeable
+                                 ? std::string("hold (not judgeable)")
+                                 : std::string(sim::to_string(phase.kind));
+    return *std::find_if(rows.begin(), rows.end(),
+                         [&](const PhaseKindScore& row) { return row.phase == name; });
+  };
+  const std::size_t t = design_index(candidates()[candidate]);
+  for (const auto& r : results) {
+    const RunSpec& spec = r.spec;
+    if (spec.phases.empty() || spec.sensor_fault_run || spec.wear_run()) continue;
+    const double healthy_end = std::min(spec.onset, r.seconds);
+    for (const ProgramPhase& phase : spec.phases) {
+      const double from = std::max(phase.start, spec.monitor_from);
+      const double to = std::min(phase.end, healthy_end);
+      if (to > from) row_of(phase).healthy_hours += (to - from) / 3600.0;
+    }
+    const auto& alarms = r.alarms[candidate][t];
+    for (const auto& a : alarms) {
+      if (a.raised >= healthy_end) continue;
+      const int i = spec.phase_at(a.raised);
+      if (i < 0) continue;
+      const auto at = static_cast<std::size_t>(i);
+      PhaseKindScore& row = row_of(spec.phases[at]);
+      ++row.false_alarms;
+      if (a.raised - spec.phases[at].start <= kPhaseStartSeconds) {
+        ++row.early_false_alarms;
+        if (at > 0 && spec.phases[at - 1].kind == sim::PhaseKind::hold) {
+          ++row.after_hold_false_alarms;
+        }
+      }
+    }
+    if (spec.leak <= 0.0 || spec.leak_phase < 0) continue;
+    const ProgramPhase& opened_in = spec.phases[static_cast<std::size_t>(spec.leak_phase)];
+    PhaseKindScore& row = row_of(opened_in);
+    ++row.leak_runs;
+    const double deadline = spec.detection_deadline(detect_within);
+    for (const auto& a : alarms) {
+      if (a.raised < spec.onset) continue;
+      if (a.raised <= deadline) {
+        ++row.found;
+        row.delays.push_back(a.raised - (opened_in.judgeable ? spec.onset : opened_in.end));
+      } else {
+        ++row.found_late;
+      }
+      break;
+    }
+  }
+  return rows;
+}
+
+std::vector<ProgramStartScore> score_program_starts(const std::vector<RunResult>& results,
+                                                    std::size_t candidate) {
+  std::vector<ProgramStartScore> rows = {{.starts_with_hold = true}, {.starts_with_hold = false}};
+  const std::size_t t = design_index(candidates()[candidate]);
+  for (const auto& r : results) {
+    const RunSpec& spec = r.spec;
+    if (spec.phases.empty() || spec.sensor_fault_run || spec.wear_run()) continue;
+    ProgramStartScore& row = rows[spec.phases.front().kind == sim::PhaseKind::hold ? 0 : 1];
+    const double healthy_end = std::min(spec.onset, r.seconds);
+    ++row.runs;
+    row.healthy_hours += std::max(0.0, healthy_end - spec.monitor_from) / 3600.0;
+    int raised = 0;
+    for (const auto& a : r.alarms[candidate][t]) raised += a.raised < healthy_end ? 1 : 0;
+    row.false_alarms += raised;
+    row.runs_with_false_alarm += raised > 0 ? 1 : 0;
+  }
+  return rows;
+}
+
+std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate) {
+  std::vector<WearScore> rows = {
+      {.growth = "all"}, {.growth = "slow"}, {.growth = "medium"}, {.growth = "fast"}};
+  const std::size_t t = design_index(candidates()[candidate]);
+  for (const auto& r : results) {
+    const RunSpec& spec = r.spec;
+    if (!spec.wear_run() || spec.leak <= 0.0) continue;
+    const double per_hour = spec.leak / (spec.wear_seconds / 3600.0);
+    WearScore& band = rows[per_hour < kWearSlow ? 1 : per_hour < kWearFast ? 2 : 3];
+    for (WearScore* row : {&rows[0], &band}) {
+      ++row->runs;
+      for (const auto& a : r.alarms[candidate][t]) {
+        if (a.raised < spec.onset) continue;
+        const double size = spec.leak_at(a.raised);
+        ++row->found;
+        row->found_before_target += size <= kWearTarget ? 1 : 0;
+        row->found_at.push_back(size);
+        break;
+      }
+    }
+  }
+  return rows;
 }
 
 }  // namespace leakmon::study

@@ -103,6 +103,55 @@ struct RestartScore {
 RestartScore score_restarts(const std::vector<RunResult>& results, std::size_t candidate,
                             double detect_within);
 
+// Test programs (the `programs` condition), one candidate at its design threshold, per phase
+// kind: holds whose load |K_s X| / A stays below kJudgeableLoad are a row of their own. Healthy
+// time is the monitored time before any onset that the runs spent in phases of the kind; a false
+// alarm belongs to the phase it was raised in. A leak belongs to the phase it opened in and is
+// found when raised by RunSpec::detection_deadline.
+inline constexpr double kPhaseStartSeconds = 30.0;  // "just after a program change"
+struct PhaseKindScore {
+  std::string phase;  // "steps", "hold", "hold (not judgeable)", "sine", "sweep", "triangle"
+  double healthy_hours = 0.0;
+  int false_alarms = 0;
+  int early_false_alarms = 0;       // within kPhaseStartSeconds of the phase's start
+  int after_hold_false_alarms = 0;  // ... of those, in a phase that follows a hold
+  int leak_runs = 0;
+  int found = 0;       // raised by the deadline
+  int found_late = 0;  // raised first after the deadline, before the run's end
+  // Of the leaks found: raise - onset, or raise - the next phase's start for a phase that
+  // cannot be judged.
+  std::vector<double> delays = {};
+  double false_alarms_per_hour() const;
+  double false_alarms_per_hour_upper_95() const;  // NaN without healthy time
+};
+std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& results,
+                                                 std::size_t candidate, double detect_within);
+
+// Program runs split by how the program starts (with a hold or not): their healthy time and
+// false alarms, for one candidate at its design threshold.
+struct ProgramStartScore {
+  bool starts_with_hold = false;
+  int runs = 0, runs_with_false_alarm = 0;
+  double healthy_hours = 0.0;
+  int false_alarms = 0;
+};
+std::vector<ProgramStartScore> score_program_starts(const std::vector<RunResult>& results,
+                                                    std::size_t candidate);
+
+// Seals that wear (the `wear` condition), one candidate at its design threshold: the C_L in force
+// at the first raise after the onset, and whether that came before C_L passed kWearTarget.
+// Grouped by growth rate C_L / wear time: slow (below kWearSlow per hour), medium, fast (at or
+// above kWearFast per hour), and all.
+inline constexpr double kWearTarget = 1.5e-12;  // m^3/(s Pa)
+inline constexpr double kWearSlow = 1e-12;      // m^3/(s Pa) per hour
+inline constexpr double kWearFast = 1e-11;      // m^3/(s Pa) per hour
+struct WearScore {
+  std::string growth;  // "all", "slow", "medium", "fast"
+  int runs = 0, found = 0, found_before_target = 0;
+  std::vector<double> found_at = {};  // C_L at the first raise after the onset [m^3/(s Pa)]
+};
+std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate);
+
 // The controller groups the summaries report: "all" and each controller.
 inline constexpr std::array<std::string_view, 3> kControllerGroups = {"all", "basic",
                                                                       "fault_tolerant"};

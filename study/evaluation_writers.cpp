@@ -101,6 +101,99 @@ void write_restart_table(fmt::ostream& f, const std::vector<RunResult>& results,
   }
 }
 
+// Test programs per phase kind, and split by how the program starts: conditions.md and
+// programs.tsv.
+void write_program_tables(fmt::ostream& f, const std::filesystem::path& dir,
+                          const std::vector<RunResult>& results, double detect_within) {
+  bool any = false;
+  for (const auto& r : results) any = any || !r.spec.phases.empty();
+  if (!any) return;
+  const auto all = candidates();
+  auto tsv = fmt::output_file((dir / "programs.tsv").string());
+  tsv.print(
+      "detector\tphase\thealthy_hours\tfalse_alarms\tfa_per_hour\tfa_upper_95\t"
+      "fa_first_{0:.0f}s\tfa_first_{0:.0f}s_after_hold\tleak_runs\tfound\tfound_late\t"
+      "median_delay\n",
+      kPhaseStartSeconds);
+  f.print(
+      "\nTest programs per phase kind (design thresholds). Healthy time: monitored, before any "
+      "onset, in phases of the kind; a false alarm counts in the phase it was raised in. A leak "
+      "counts in the phase it opened in and is found when raised within {0:.0f} s of its onset, "
+      "or, in a hold whose |K_s X| / A stays below {1:g} MPa (not judgeable), within {0:.0f} s "
+      "of the next phase's start (the delay is then counted from that start).\n\n"
+      "| detector | phase | healthy h | false alarms / h (count; 95 % upper bound) | of them in "
+      "the phase's first {2:.0f} s (after a hold) | leaks found in time (95 % CI) | found later "
+      "| median delay |\n|---|---|---|---|---|---|---|---|\n",
+      detect_within, kJudgeableLoad / 1e6, kPhaseStartSeconds);
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    for (const PhaseKindScore& row : score_program_phases(results, c, detect_within)) {
+      f.print("| {} | {} | {:.2f} | {:.2f} ({}; <= {:.2f}) | {} ({}) | {} | {} | {} |\n",
+              all[c].label, row.phase, row.healthy_hours, row.false_alarms_per_hour(),
+              row.false_alarms, row.false_alarms_per_hour_upper_95(), row.early_false_alarms,
+              row.after_hold_false_alarms, percent_interval(row.found, row.leak_runs),
+              row.found_late, median_text(row.delays, " s"));
+      std::vector<double> delays = row.delays;
+      std::sort(delays.begin(), delays.end());
+      tsv.print("{}\t{}\t{:.4g}\t{}\t{:.4g}\t{:.4g}\t{}\t{}\t{}\t{}\t{}\t{:.4g}\n", all[c].label,
+                row.phase, row.healthy_hours, row.false_alarms, row.false_alarms_per_hour(),
+                row.false_alarms_per_hour_upper_95(), row.early_false_alarms,
+                row.after_hold_false_alarms, row.leak_runs, row.found, row.found_late,
+                delays.empty() ? NAN : delays[delays.size() / 2]);
+    }
+  }
+  f.print(
+      "\nTest programs by how they start (design thresholds; healthy time and false alarms of "
+      "the program runs):\n\n| detector | program starts with | runs | healthy h | false alarms "
+      "/ h (count; 95 % upper bound) | runs with a false alarm |\n|---|---|---|---|---|---|\n");
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    for (const ProgramStartScore& row : score_program_starts(results, c)) {
+      const double hours = row.healthy_hours;
+      f.print("| {} | {} | {} | {:.2f} | {:.2f} ({}; <= {:.2f}) | {} |\n", all[c].label,
+              row.starts_with_hold ? "a hold" : "another phase", row.runs, hours,
+              hours > 0 ? row.false_alarms / hours : NAN, row.false_alarms,
+              hours > 0 ? poisson_upper_95(row.false_alarms) / hours : NAN,
+              row.runs_with_false_alarm);
+    }
+  }
+}
+
+// Seals that wear: the C_L at which each candidate finds them, and whether before kWearTarget,
+// per growth rate: conditions.md and wear.tsv.
+void write_wear_table(fmt::ostream& f, const std::filesystem::path& dir,
+                      const std::vector<RunResult>& results) {
+  bool any = false;
+  for (const auto& r : results) any = any || (r.spec.wear_run() && r.spec.leak > 0.0);
+  if (!any) return;
+  const auto all = candidates();
+  auto tsv = fmt::output_file((dir / "wear.tsv").string());
+  tsv.print("detector\tgrowth\truns\tfound\tfound_before_target\tmedian_found_at\n");
+  f.print(
+      "\nSeals that wear (design thresholds; C_L from 0 to 1e-12..5e-12 over 10 min to 4 h; found "
+      "= the first raise after the wear began, with the C_L in force then; growth = final C_L / "
+      "wear time, slow < {:g}, fast >= {:g} m^3/(s Pa) per hour):\n\n"
+      "| detector | found | found before C_L = {:g} (95 % CI) | median C_L when found | slow: "
+      "before {:g} | medium | fast |\n|---|---|---|---|---|---|---|\n",
+      kWearSlow, kWearFast, kWearTarget, kWearTarget);
+  for (std::size_t c = 0; c < all.size(); ++c) {
+    const std::vector<WearScore> rows = score_wear(results, c);
+    auto median_size = [](std::vector<double> v) {
+      if (v.empty()) return std::string("-");
+      std::sort(v.begin(), v.end());
+      return fmt::format("{:.2g}", v[v.size() / 2]);
+    };
+    f.print("| {} | {}/{} | {} | {} | {}/{} | {}/{} | {}/{} |\n", all[c].label, rows[0].found,
+            rows[0].runs, percent_interval(rows[0].found_before_target, rows[0].runs),
+            median_size(rows[0].found_at), rows[1].found_before_target, rows[1].runs,
+            rows[2].found_before_target, rows[2].runs, rows[3].found_before_target, rows[3].runs);
+    for (const WearScore& row : rows) {
+      std::vector<double> sizes = row.found_at;
+      std::sort(sizes.begin(), sizes.end());
+      tsv.print("{}\t{}\t{}\t{}\t{}\t{:.4g}\n", all[c].label, row.growth, row.runs, row.found,
+                row.found_before_target, sizes.empty() ? NAN : sizes[sizes.size() / 2]);
+    }
+  }
+}
+
 }  // namespace
 
 void write_runs_json(const std::filesystem::path& path, const std::vector<RunResult>& results) {
@@ -149,6 +242,20 @@ void write_runs_json(const std::filesystem::path& path, const std::vector<RunRes
           "\"temp_before\": {}, \"temp_after\": {}, \"states_restored\": {}}}",
           json_number(r.spec.stop_at), json_number(r.spec.downtime), json_number(r.spec.restart_at),
           json_number(r.spec.temp_before), json_number(r.spec.temp_after), r.states_restored);
+    }
+    if (!r.spec.phases.empty()) {
+      f.print(", \"program\": [");
+      for (std::size_t p = 0; p < r.spec.phases.size(); ++p) {
+        const ProgramPhase& phase = r.spec.phases[p];
+        f.print("{}{{\"phase\": \"{}\", \"start\": {}, \"end\": {}, \"judgeable\": {}}}",
+                p ? ", " : "", phase.notation, json_number(phase.start), json_number(phase.end),
+                phase.judgeable ? "true" : "false");
+      }
+      f.print("], \"leak_phase\": {}",
+              r.spec.leak_phase >= 0 ? fmt::format("{}", r.spec.leak_phase) : "null");
+    }
+    if (r.spec.wear_run()) {
+      f.print(", \"wear_seconds\": {}", json_number(r.spec.wear_seconds));
     }
     const SizeCheck& size = r.size_check;
     f.print(
@@ -257,6 +364,9 @@ void write_summaries(const std::filesystem::path& dir, const EvaluationOptions& 
 void write_condition_summaries(const std::filesystem::path& dir, const EvaluationOptions& options,
                                const std::vector<RunResult>& results) {
   const auto all = candidates();
+  // Written below only when the runs have programs or wear: none left from an earlier run.
+  std::filesystem::remove(dir / "programs.tsv");
+  std::filesystem::remove(dir / "wear.tsv");
   auto f_md = fmt::output_file((dir / "conditions.md").string());
   auto f_tsv = fmt::output_file((dir / "conditions.tsv").string());
   f_tsv.print(
@@ -296,6 +406,8 @@ void write_condition_summaries(const std::filesystem::path& dir, const Evaluatio
   }
   write_sensor_fault_table(f_md, results, options.detect_within);
   write_restart_table(f_md, results, options.detect_within);
+  write_program_tables(f_md, dir, results, options.detect_within);
+  write_wear_table(f_md, dir, results);
 }
 
 }  // namespace leakmon::study

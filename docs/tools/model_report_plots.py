@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Figures of a `leakmon model check --report DIR` report, from DIR/residuals.csv:
 residual time series, residuals against the physical regressors of MODEL.md, residual spectra."""
+import json
 import sys
 
 import matplotlib
@@ -21,6 +22,19 @@ def main(out_dir):
         ax.plot(t, (d[c + "_before"] - d[c]) * scale, ".", ms=1, label="nominal (calibrated)")
         ax.plot(t, (d[c + "_after"] - d[c]) * scale, ".", ms=1, label="extended")
         ax.set_ylabel(f"{c} residual [{unit}]")
+    # Effects that start inside the capture (result.json's causes with onset_s): marked.
+    try:
+        with open(f"{out_dir}/result.json") as f:
+            causes = json.load(f).get("causes", [])
+    except (OSError, ValueError):
+        causes = []
+    for cause in causes:
+        if "onset_s" in cause:
+            for ax in axes:
+                ax.axvline(cause["onset_s"], color="red", lw=1, ls="--")
+            axes[0].annotate(f"{cause['cause']} from t = {cause['onset_s']:.2f} s",
+                             (cause["onset_s"], 1.0), xycoords=("data", "axes fraction"),
+                             xytext=(3, -12), textcoords="offset points", color="red")
     axes[0].legend(markerscale=8)
     axes[-1].set_xlabel("t [s] (held-out segments)")
     fig.tight_layout()

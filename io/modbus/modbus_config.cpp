@@ -6,6 +6,8 @@
 #include <cmath>
 #include <set>
 
+#include "config/address.hpp"
+
 namespace leakmon::io::modbus {
 namespace {
 
@@ -111,8 +113,7 @@ ModbusConfig parse_connection(const ConfigNode& node) {
   if (transport == "tcp") {
     reject({"device", "baud", "parity", "data_bits", "stop_bits"});
     TcpEndpoint tcp;
-    tcp.host = node.get_string("host");
-    if (tcp.host.empty()) node.at("host").fail("host must not be empty");
+    tcp.host = config::read_host(node.at("host"));
     tcp.port = static_cast<int>(node.get_int("port", 502, 1, 65535));
     config.tcp = tcp;
   } else {
@@ -166,10 +167,28 @@ ModbusConfig parse_modbus_config(const ConfigNode& node) {
 
   const ConfigNode channels = node.at("channels");
   std::set<std::string> names;
+  std::vector<ConfigNode> addresses;
   for (const ConfigNode& item : channels.items()) {
     ChannelSpec channel = parse_channel(item, default_unit, address_base, default_max_age_ms);
     if (!names.insert(channel.name).second)
       item.at("name").fail(fmt::format("duplicate channel name '{}'", channel.name));
+    // Two channels on the same registers read the same data twice: usually a copied entry
+    // whose address was not changed. Legal (a FLOAT32 and its INT16 halves, say), so a warning.
+    for (std::size_t k = 0; k < config.channels.size(); ++k) {
+      const ChannelSpec& other = config.channels[k];
+      if (other.unit_id != channel.unit_id || other.register_type != channel.register_type ||
+          other.address + other.width() <= channel.address ||
+          channel.address + channel.width() <= other.address) {
+        continue;
+      }
+      config.warnings.push_back(fmt::format(
+          "{}: {}: channel '{}' reads {} {}..{} of unit {}, which channel '{}' ({}) also reads",
+          item.at("address").location(), item.at("address").path(), channel.name,
+          is_bit_type(channel.register_type) ? "bits" : "registers", channel.address + address_base,
+          channel.address + address_base + channel.width() - 1, channel.unit_id, other.name,
+          addresses[k].location()));
+    }
+    addresses.push_back(item.at("address"));
     config.channels.push_back(std::move(channel));
   }
   if (config.channels.empty()) channels.fail("at least one channel is required");

@@ -62,6 +62,9 @@ struct ModbusConfig {
   std::int64_t reconnect_max_ns = 5'000'000'000;
   int max_registers_per_request = 125;
   std::vector<ChannelSpec> channels;
+  // Findings that are legal but probably mistakes (two channels on the same registers), each
+  // `file:line:column: message`; check-config prints them and `run` logs them.
+  std::vector<std::string> warnings;
 
   std::string endpoint() const;  // "tcp://host:port" or "rtu:/dev/ttyUSB0@19200,8E1", for logs
 };

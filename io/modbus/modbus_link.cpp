@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <modbus/modbus.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <vector>
 
 #include "io/driver.hpp"
 
@@ -122,6 +124,25 @@ Outcome ModbusLink::write_registers(int unit_id, int address,
   modbus_set_slave(context_, unit_id);
   const int count = static_cast<int>(words.size());
   return classify(modbus_write_registers(context_, address, count, words.data()), count);
+}
+
+std::string unanswered(const ModbusConfig& config) {
+  ModbusConfig patient = config;
+  patient.timeout_ns = std::max<std::int64_t>(config.timeout_ns, 1'000'000'000);
+  ModbusLink link(patient);
+  if (link.connect() != Outcome::ok) return link.last_error();
+  const auto plan = plan_requests(config.channels, config.max_registers_per_request);
+  if (plan.empty()) return "";
+  const ReadRequest& first = plan.front();
+  std::vector<std::uint16_t> words(static_cast<std::size_t>(first.count));
+  std::vector<std::uint8_t> bits(static_cast<std::size_t>(first.count));
+  const Outcome outcome = link.read(first, words, bits);
+  if (outcome == Outcome::ok || outcome == Outcome::exception_reply) return "";
+  if (outcome == Outcome::timeout) {
+    return fmt::format("connected, but no answer to a read within {} ms",
+                       patient.timeout_ns / 1'000'000);
+  }
+  return fmt::format("{}: {}", to_string(outcome), link.last_error());
 }
 
 void ModbusLink::recover(Outcome failure) {

@@ -61,4 +61,10 @@ class ModbusLink {
   std::string last_error_;
 };
 
+// Whether the device of `config` answers (`leakmon check-config`): connects and sends the first
+// read of the driver's request plan once, waiting at least a second. An exception reply is an
+// answer (the device is there and said no; the driver reports it per request). Empty when it
+// answered, else what happened ("Connection refused", "no answer within 1000 ms", ...).
+std::string unanswered(const ModbusConfig& config);
+
 }  // namespace leakmon::io::modbus

@@ -20,6 +20,7 @@
 #include <system_error>
 #include <thread>
 
+#include "config/address.hpp"
 #include "config/paths.hpp"
 #include "io/event_json.hpp"
 
@@ -66,12 +67,11 @@ std::string topic_level(std::string_view name) {
 
 MqttSettings parse_mqtt_settings(const config::ConfigNode& node) {
   node.expect_keys({"name", "type", "host", "port", "topic", "client_id", "username", "password",
-                    "tls", "keepalive_s", "features_hz", "connect_timeout_s", "reconnect_max_s",
-                    "queue"});
+                    "password_file", "tls", "keepalive_s", "features_hz", "connect_timeout_s",
+                    "reconnect_max_s", "queue"});
   MqttSettings s;
   s.name = node.get_string("name");
-  s.host = node.get_string("host", "127.0.0.1");
-  if (s.host.empty()) node.at("host").fail("the broker host must not be empty");
+  s.host = node.has("host") ? config::read_host(node.at("host")) : "127.0.0.1";
   const auto topic = node.at("topic");
   s.topic = topic.as_string();
   check_topic(topic, s.topic);
@@ -84,7 +84,13 @@ MqttSettings parse_mqtt_settings(const config::ConfigNode& node) {
   s.username = node.get_string("username", "");
   if (auto password = node.find("password")) {
     if (s.username.empty()) password->fail("a password needs a username");
+    if (node.has("password_file")) password->fail("give either password or password_file");
     s.password = password->as_string();
+  }
+  if (auto file = node.find("password_file")) {
+    // Kept out of the configuration: a root-only file or a systemd credential (README.md).
+    if (s.username.empty()) file->fail("a password needs a username");
+    s.password = config::read_secret(*file);
   }
   if (auto tls = node.find("tls")) {
     tls->expect_keys({"ca_file", "ca_path", "cert_file", "key_file"});

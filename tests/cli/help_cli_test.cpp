@@ -33,8 +33,9 @@ Outcome run_leakmon(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text.str()};
 }
 
-constexpr const char* kSubcommands[] = {"run",      "replay", "check-config", "status",   "ack",
-                                        "features", "sim",    "evaluate",     "realdata", "model"};
+constexpr const char* kSubcommands[] = {"run",      "replay",   "check-config", "probe",
+                                        "status",   "ack",      "features",     "sim",
+                                        "evaluate", "realdata", "model"};
 
 TEST(CliHelp, EverySubcommandPrintsItsUsage) {
   for (const char* name : kSubcommands) {

@@ -66,6 +66,45 @@ TEST(ConfigNode, SyntaxErrorHasLocation) {
   EXPECT_NE(message.find(':', 9), std::string::npos);
 }
 
+// Issue 25: a bad indentation gave a bare `end of map not found`. The message now says what is
+// probably wrong, and keeps the parser's words and the location.
+TEST(ConfigNode, SyntaxErrorsSayWhatIsProbablyWrong) {
+  const auto message = [](const std::string& text) {
+    return error_of([&] { ConfigNode::load_string(text, "rig.yaml"); });
+  };
+  // A key indented one space less than its siblings.
+  EXPECT_EQ(message("metrics:\n  port: 9187\n address: 127.0.0.1\n"),
+            "rig.yaml:3:2: probably wrong indentation: line 3 starts at column 2, but the blocks "
+            "above start at columns 1, 3; entries of one mapping or list start in the same column "
+            "(YAML parser: end of map not found)");
+  // Inside a list item.
+  const std::string in_list =
+      message("drivers:\n  - name: rig\n    type: sim\n   seed: 7\nactuators: []\n");
+  EXPECT_NE(in_list.find("rig.yaml:4:4: probably wrong indentation: line 4 starts at column 4, "
+                         "but the blocks above start at columns 1, 3, 5"),
+            std::string::npos)
+      << in_list;
+  // Indented deeper than its siblings: it continues the value above.
+  const std::string deeper = message("drivers:\n  - name: rig\n    type: sim\n      seed: 7\n");
+  EXPECT_NE(deeper.find("rig.yaml:4:11: probably wrong indentation: line 4 starts at column 7, "
+                        "deeper than line 3 (column 5)"),
+            std::string::npos)
+      << deeper;
+  // Tabs.
+  const std::string tab = message("drivers:\n  - name: rig\n\ttype: sim\n");
+  EXPECT_NE(tab.find("rig.yaml:3:1: line 3 is indented with a tab: YAML indents with spaces only"),
+            std::string::npos)
+      << tab;
+  // An unquoted ': ' in a value; an unclosed inline mapping.
+  EXPECT_NE(message("message: leak: big\n").find("a value that contains ': ' must be quoted"),
+            std::string::npos);
+  EXPECT_NE(message("channels: {p1: rig.p1, p2: rig.p2\nevents: {}\n")
+                .find("an inline mapping opened with '{' is not closed with '}'"),
+            std::string::npos);
+  EXPECT_NE(message("a: [1, 2\nb: 3\n").find("an inline list opened with '[' is not closed"),
+            std::string::npos);
+}
+
 TEST(ConfigNode, MissingFileIsAnError) {
   EXPECT_EQ(error_of([] { ConfigNode::load_file("/nonexistent/leakmon.yaml"); }),
             "/nonexistent/leakmon.yaml: cannot open file");

@@ -184,6 +184,40 @@ constexpr const char* kBase =
     "actuators: [{name: a, channels: {p1: p1}}]\n"
     "state: {directory: ''}\n";
 
+// Issue 25: leak sizes in the unit a rig engineer reads (l/min/MPa), where the configuration
+// takes one; the detector still receives m^3/(s Pa), and mistakes name file:line:column.
+TEST(DaemonConfig, LeakSizesMayBeGivenInLitresPerMinutePerMegapascal) {
+  const std::string actuator =
+      "actuators:\n"
+      "  - name: a\n"
+      "    channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x}\n"
+      "    detector:\n"
+      "      kind: flow_balance\n"
+      "      options:\n";
+  const auto config =
+      parse_config(config::ConfigNode::load_string(std::string(kDriver) + actuator +
+                                                       "        min_leak: 0.03 l/min/MPa\n"
+                                                       "        design_leak: 0.015l/min/MPa\n"
+                                                       "        learn_seconds: 30\n",
+                                                   "rig.yaml"));
+  const auto& options = *config.actuators.at(0).detector_options;
+  EXPECT_NEAR(options.at("min_leak").as_double(), 5e-13, 1e-27);
+  EXPECT_NEAR(options.at("design_leak").as_double(), 2.5e-13, 1e-27);
+  EXPECT_EQ(options.at("learn_seconds").as_double(), 30.0);
+  // The detector is built from them, as check-config does.
+  std::vector<std::vector<std::string>> channels{{"p1", "p2", "u", "x"}};
+  EXPECT_NO_THROW(check_channels(config, channels));
+  EXPECT_EQ(error_of(std::string(kDriver) + actuator + "        learn_seconds: 3 l/min/MPa\n"),
+            "rig.yaml:8:24: actuators[0].detector.options.learn_seconds: learn_seconds is not a "
+            "leak size (l/min/MPa applies to design_leak and min_leak)");
+  EXPECT_EQ(error_of(std::string(kDriver) + actuator + "        min_leak: lots l/min/MPa\n"),
+            "rig.yaml:8:19: actuators[0].detector.options.min_leak: expected a number followed "
+            "by l/min/MPa (e.g. 0.03 l/min/MPa), got 'lots l/min/MPa'");
+  EXPECT_NE(error_of(std::string(kDriver) + actuator + "        min_leak: 0.03 l/min/MPa/s\n")
+                .find("expected a number followed by l/min/MPa"),
+            std::string::npos);
+}
+
 TEST(DaemonConfig, MetricsAddressMustBeAnIpv4Address) {
   const std::string dir = test::scratch_dir("config_preflight_address");
   for (const char* address : {"256.1.1.1", "localhost", "1.2.3", "::1"}) {
@@ -300,6 +334,87 @@ TEST(DaemonConfig, NamesWithControlCharactersAreRejectedAndEscaped) {
   EXPECT_NE(e.find("must be printable text"), std::string::npos) << e;
   EXPECT_EQ(e.find('\x1b'), std::string::npos) << "raw ESC in the message";
   EXPECT_NE(e.find("r\\x1b[31mig"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace leakmon::daemon
+
+namespace leakmon::daemon {
+namespace {
+
+// An actuator's `rig:` (FORMATS.md): read with the one rig reader, its supply sets the pressure
+// transducers' default range, and a value given both there and in the detector's options is
+// valid but warned about, naming both places.
+TEST(DaemonConfig, AnActuatorsRigIsReadAndSetsTheTransducersRange) {
+  const auto config = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) +
+          "actuators:\n"
+          "  - name: a\n"
+          "    channels: {p1: p1, p2: p2}\n"
+          "    rig: {bore: 0.05, rod: 0.028, supply_pressure: 21.0e6, valve_coefficient: 5.3e-7}\n"
+          "  - name: b\n"
+          "    channels: {p1: p1}\n"
+          "    rig: {supply_pressure: 21.0e6}\n"
+          "    transducers: {p1: {max: 40.0e6}}\n"
+          "  - name: c\n"
+          "    channels: {p1: p1}\n",
+      "rig.yaml"));
+  const auto& a = config.actuators.at(0);
+  EXPECT_EQ(a.rig.stated,
+            (std::vector<std::string>{"bore", "rod", "supply_pressure", "valve_coefficient"}));
+  EXPECT_DOUBLE_EQ(a.rig.params.ps, 21.0e6);
+  EXPECT_DOUBLE_EQ(a.rig.params.Kv, 5.3e-7);
+  EXPECT_EQ(a.rig.source, "rig.yaml:5:10");
+  // 21 MPa: the 25 MPa range (sim::sensors_for), 12 bit, for both chambers.
+  EXPECT_DOUBLE_EQ(a.transducers[capture::Role::p1].max, 25e6);
+  EXPECT_DOUBLE_EQ(a.p2_transducer.resolution, 25e6 / 4096.0);
+  // A configured transducer range wins; without a rig, MODEL.md's 20.7 MPa.
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).transducers[capture::Role::p1].max, 40e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).p2_transducer.max, 25e6);
+  EXPECT_TRUE(config.actuators.at(2).rig.nominal());
+  EXPECT_DOUBLE_EQ(config.actuators.at(2).transducers[capture::Role::p1].max, 20.7e6);
+  EXPECT_TRUE(config.warnings.empty());
+
+  const std::string e = error_of(std::string(kDriver) +
+                                 "actuators:\n"
+                                 "  - name: a\n"
+                                 "    channels: {p1: p1}\n"
+                                 "    rig:\n"
+                                 "      bore: 0.05\n"
+                                 "      supply: 21.0e6\n");
+  EXPECT_NE(e.find("rig.yaml:7:15"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown rig key 'supply'"), std::string::npos) << e;
+}
+
+TEST(DaemonConfig, AValueInBothTheRigAndTheDetectorOptionsIsWarnedAboutWithBothPlaces) {
+  const auto config = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) + "actuators:\n"
+                             "  - name: a\n"
+                             "    channels: {p1: p1, p2: p2, u: u, x: x}\n"
+                             "    rig:\n"
+                             "      bore: 0.05\n"
+                             "      supply_pressure: 21.0e6\n"
+                             "      valve_rated_flow: 1.0e-3\n"
+                             "      valve_rated_pressure_drop: 7.0e6\n"
+                             "    detector:\n"
+                             "      kind: flow_balance\n"
+                             "      options:\n"
+                             "        supply_pressure: 20.0e6\n"
+                             "        valve_coefficient: 5.0e-7\n"
+                             "        piston_area: 1.3e-3\n"
+                             "        min_leak: 1.0e-13\n",
+      "rig.yaml"));
+  ASSERT_EQ(config.warnings.size(), 3u);
+  const std::string& supply = config.warnings[0];
+  EXPECT_EQ(supply.rfind("rig.yaml:13:26: ", 0), 0u) << supply;
+  EXPECT_NE(supply.find("supply_pressure at rig.yaml:7:24"), std::string::npos) << supply;
+  EXPECT_NE(supply.find("actuator 'a'"), std::string::npos) << supply;
+  EXPECT_NE(config.warnings[1].find("valve_rated_flow at rig.yaml:8:25"), std::string::npos)
+      << config.warnings[1];
+  // The piston area restates the bore (the rod is the paper's, unstated).
+  EXPECT_NE(config.warnings[2].find("bore at rig.yaml:6:13"), std::string::npos)
+      << config.warnings[2];
+  EXPECT_EQ(config.warnings[2].find("rod at"), std::string::npos) << config.warnings[2];
 }
 
 }  // namespace

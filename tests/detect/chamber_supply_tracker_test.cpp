@@ -104,7 +104,9 @@ TEST(ChamberSupplyTracker, StateRoundTripsWhileAwaitingANewLevel) {
   }
   ASSERT_TRUE(a.awaiting());
   ChamberSupplyTracker b;
-  b.import_values(a.export_values());
+  DetectorState saved("probe", 1);
+  a.save(saved, "chamber");
+  b.restore(DetectorState::parse(saved.text()), "chamber");
   EXPECT_TRUE(b.awaiting());
   EXPECT_EQ(b.step_time(), a.step_time());
   ChamberRig twin = rig;  // the same data follows for both
@@ -114,12 +116,21 @@ TEST(ChamberSupplyTracker, StateRoundTripsWhileAwaitingANewLevel) {
   ASSERT_FALSE(after_a.empty());
   EXPECT_EQ(a.mid_shift(), b.mid_shift());
 
-  std::vector<double> values = a.export_values();
-  values.pop_back();
-  EXPECT_THROW(b.import_values(values), StateError);
-  values = a.export_values();
-  values[1] = 1e9;  // a count beyond the ring
-  EXPECT_THROW(b.import_values(values), StateError);
+  // Every value has a name; a ring that does not fit and a count out of range do not load.
+  DetectorState named("probe", 1);
+  a.save(named, "chamber");
+  EXPECT_TRUE(named.has("chamber.learned_mid"));
+  EXPECT_TRUE(named.has("chamber.holds.level"));
+  DetectorState shorter = named;
+  auto levels = shorter.get_list("chamber.holds.level");
+  levels.pop_back();
+  shorter.put("chamber.holds.level", levels);
+  EXPECT_THROW(b.restore(shorter, "chamber"), StateError);
+  DetectorState beyond = named;
+  beyond.put_count("chamber.holds.next", 1000000000);
+  EXPECT_THROW(b.restore(beyond, "chamber"), StateError);
+  ChamberSupplyTracker small(16);
+  EXPECT_THROW(small.restore(named, "chamber"), StateError) << "a ring of another size";
 }
 
 }  // namespace

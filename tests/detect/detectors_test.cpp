@@ -1,14 +1,21 @@
 // Detectors on synthetic observation streams with known truth (synthetic_rig.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "detect/factory.hpp"
 #include "detect/fused_detector.hpp"
 #include "tests/detect/synthetic_pressures.hpp"
 #include "tests/detect/synthetic_rig.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/support/paths.hpp"
 
 namespace leakmon::detect {
 namespace {
@@ -54,6 +61,75 @@ TEST(DetectorFactory, OptionErrorsNameFileLineAndKey) {
   const auto good = config::ConfigNode::load_string(
       "learn_seconds: 30\ndesign_leak: 2.0e-12\nrest_speed: 0.003\n", "good.yaml");
   EXPECT_EQ(make_detector("default", kAll, 0.04, &good)->name(), "flow_balance");
+}
+
+// One table per kind: its keys are what the configuration accepts, in the order the error
+// message lists them, and the same as before the registry (issue 26 renamed none).
+TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
+  const std::vector<std::string> learning = {"settle_seconds", "learn_seconds"};
+  auto with_learning = [&](std::vector<std::string> keys) {
+    keys.insert(keys.begin(), learning.begin(), learning.end());
+    return keys;
+  };
+  const std::vector<std::string> index =
+      with_learning({"design_drop", "false_alarms_per_hour", "block_seconds", "supply_pressure",
+                     "tank_pressure", "min_drop", "temperature_prior", "temperature_prior_sigma",
+                     "drift_guard_seconds", "drift_window_seconds", "supply_settle_seconds",
+                     "oil_grade", "oil_viscosity_40", "oil_viscosity_100"});
+  const std::vector<std::string> flow =
+      with_learning({"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
+                     "valve_coefficient_uncertainty", "piston_area", "rest_speed", "design_leak",
+                     "false_alarms_per_hour", "block_seconds", "sizing_seconds", "min_leak",
+                     "drift_guard_seconds", "drift_window_seconds", "estimate_supply", "oil_grade",
+                     "oil_viscosity_40", "oil_viscosity_100"});
+  std::vector<std::string> fused = index;
+  for (const auto& key : flow) {
+    if (std::find(fused.begin(), fused.end(), key) == fused.end()) fused.push_back(key);
+  }
+  const std::map<std::string, std::vector<std::string>> expected = {
+      {"paper", with_learning({"baseline_quantile", "window_seconds", "raise_fraction",
+                               "clear_fraction", "channel"})},
+      {"index_cusum", index},
+      {"flow_balance", flow},
+      {"fused", fused},
+      {"detail_xcorr",
+       with_learning({"design_shift", "min_shift", "false_alarms_per_hour", "block_seconds",
+                      "supply_pressure", "tank_pressure", "drift_guard_seconds",
+                      "drift_window_seconds", "supply_settle_seconds"})}};
+  std::vector<std::string> kinds = {"default"};
+  for (const auto& kind : detector_registry()) {
+    kinds.emplace_back(kind.name);
+    ASSERT_TRUE(expected.count(std::string(kind.name))) << kind.name;
+    EXPECT_EQ(kind.option_keys(), expected.at(std::string(kind.name))) << kind.name;
+    // A key outside the table is refused.
+    const AvailableSignals signals = kind.runs_on(kPressuresOnly) ? kPressuresOnly : kAll;
+    for (const auto& key : kind.option_keys()) {
+      const auto unknown = config::ConfigNode::load_string(key + "_x: 1\n", "k.yaml");
+      EXPECT_THROW(make_detector(std::string(kind.name), signals, 0.04, &unknown),
+                   config::ConfigError)
+          << key;
+    }
+  }
+  EXPECT_EQ(detector_kinds(), kinds);
+}
+
+// docs/detection.md lists every kind's options as the registry's tables render them.
+TEST(DetectorRegistry, TheDocsHoldTheOptionTables) {
+  std::ifstream in(test::source_dir() + "/docs/detection.md");
+  std::stringstream docs;
+  docs << in.rdbuf();
+  const std::string reference = detector_options_reference();
+  EXPECT_NE(docs.str().find(reference), std::string::npos)
+      << "docs/detection.md's detector options are out of date; the tables are:\n"
+      << reference;
+  for (const auto& kind : detector_registry()) {
+    for (const auto& key : kind.option_keys()) {
+      EXPECT_NE(reference.find("`" + key + "`"), std::string::npos) << key;
+    }
+  }
+  // Defaults as the options structs hold them.
+  EXPECT_NE(reference.find("| `design_drop` | 0.08 | 0.005 to 0.9 |"), std::string::npos);
+  EXPECT_NE(reference.find("| `block_seconds` | 1.6 |"), std::string::npos) << "detail_xcorr";
 }
 
 TEST(PaperBaselineDetector, LearnsBaselineAndFlagsALargeDrop) {

@@ -139,18 +139,22 @@ TEST(BlockFeatures, MatchesPyWavelets) {
   struct Case {
     FeatureParams params;
     std::vector<double> x;
-    std::size_t request;
+    std::size_t request = 0;
   };
-  std::vector<Case> cases;
+  // Cases are filled in place: GCC 12 at -O3 reports a false -Wmaybe-uninitialized for the
+  // wavelet string of a brace-initialised Case moved into the vector.
+  std::vector<Case> cases(std::size(kModes) + 1);
   std::uint64_t seed = 200;
-  for (Mode mode : kModes) {
-    Case c{{"db8", 2, 400, 20, mode}, pressure(1300, ++seed, 5e3, true), 0};
-    c.request = oracle.sliding(c.x, "db8", std::string(mode_name(mode)), 2, 400, 20);
-    cases.push_back(std::move(c));
+  for (std::size_t i = 0; i < std::size(kModes); ++i) {
+    Case& c = cases[i];
+    c.params.mode = kModes[i];
+    c.x = pressure(1300, ++seed, 5e3, true);
+    c.request = oracle.sliding(c.x, "db8", std::string(mode_name(kModes[i])), 2, 400, 20);
   }
-  Case quiet{{"db8", 2, 400, 20, Mode::symmetric}, pressure(1300, 7, 100.0, false), 0};
+  Case& quiet = cases.back();
+  quiet.params.mode = Mode::symmetric;
+  quiet.x = pressure(1300, 7, 100.0, false);
   quiet.request = oracle.sliding(quiet.x, "db8", "symmetric", 2, 400, 20);
-  cases.push_back(std::move(quiet));
   oracle.run();
   for (const Case& c : cases) {
     const std::string label = std::string(mode_name(c.params.mode));

@@ -45,6 +45,8 @@ TEST(ModelCli, ChecksACaptureAndWritesJsonAndReport) {
   const std::string check = test::python() +
                             " -c \"import json,sys; r=json.load(open(sys.argv[1])); "
                             "assert r['cause']=='internal_leakage', r['cause']; "
+                            "assert 'onset_s' not in r['causes'][0]; "
+                            "assert r['rig']['changed']==[]; "
                             "assert abs(r['params']['C_L']/" +
                             true_value +
                             "-1)<0.25; "

@@ -240,3 +240,43 @@ TEST(ReplayStateDir, ALeakOpenedWhileDownIsFoundOnlyWhenTheStateWasKept) {
 
 }  // namespace
 }  // namespace leakmon::pipeline
+
+namespace leakmon::pipeline {
+namespace {
+
+// The rig sizes what the detector learns, so a changed `rig:` relearns like a changed option;
+// the paper's rig (nothing stated) keeps the fingerprint it had before `rig:` existed.
+TEST(StateStore, TheRigIsPartOfTheFingerprintWhenItStatesSomething) {
+  const auto base = state_fingerprint(actuator("ram"), 2'000'000);
+  for (const auto& [name, value] : base.parts) EXPECT_NE(name, "rig");
+  ActuatorConfig empty_rig = actuator("ram");
+  empty_rig.rig = sim::read_rig(config::ConfigNode::load_string("{}", "rig.yaml"));
+  EXPECT_TRUE(state_fingerprint(empty_rig, 2'000'000) == base);
+
+  ActuatorConfig described = actuator("ram");
+  described.rig =
+      sim::read_rig(config::ConfigNode::load_string("{supply_pressure: 21.0e6}", "rig.yaml"));
+  const auto with_rig = state_fingerprint(described, 2'000'000);
+  EXPECT_FALSE(with_rig == base);
+  const auto rig_part = std::find_if(with_rig.parts.begin(), with_rig.parts.end(),
+                                     [](const auto& part) { return part.first == "rig"; });
+  ASSERT_NE(rig_part, with_rig.parts.end());
+  EXPECT_EQ(rig_part->second, "supply_pressure=21000000");
+  ActuatorConfig resupplied = described;
+  resupplied.rig =
+      sim::read_rig(config::ConfigNode::load_string("{supply_pressure: 21.5e6}", "rig.yaml"));
+  EXPECT_FALSE(state_fingerprint(resupplied, 2'000'000) == with_rig);
+
+  // Saved on one rig, loaded on another: set aside, naming what changed.
+  const StateStore store(fresh_dir("StateRigChanged"));
+  ActuatorState saved = sample_state("ram");
+  saved.fingerprint = with_rig;
+  store.save(saved);
+  const auto loaded = store.load("ram", state_fingerprint(resupplied, 2'000'000));
+  EXPECT_FALSE(loaded.state);
+  EXPECT_NE(loaded.warning.find("supply_pressure=21500000"), std::string::npos) << loaded.warning;
+  EXPECT_TRUE(store.load("ram", with_rig).state);
+}
+
+}  // namespace
+}  // namespace leakmon::pipeline

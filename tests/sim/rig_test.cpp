@@ -95,6 +95,55 @@ TEST(RigStep, LeakCanBeInjectedAndHealedAtRunTime) {
   EXPECT_EQ(rig.step().q_int, 0.0);
 }
 
+// Scenario::change (issue 24: effects that appear inside a capture): the run is the plain one
+// up to the change, then the one with the effects on, without allocating; a transducer offset
+// appears in the readings at that sample and metadata names the change.
+TEST(RigStep, EffectsAppearAtTheirChange) {
+  Scenario plain = preset("healthy", 7);
+  plain.duration_s = 4.0;
+  Scenario changed = plain;
+  Effects appearing;
+  appearing.enable("sensor_offset", std::vector<EffectParameter>{{"offset", 2e5}});
+  appearing.enable("coulomb_friction", std::vector<EffectParameter>{{"F_C", 150.0}});
+  changed.change = EffectChange{2.0, appearing};
+  const auto a = testing::run(plain);
+  Rig rig(changed);
+  std::vector<RigSample> b;
+  b.reserve(changed.samples());
+  {
+    test::AllocationScope scope;
+    for (std::uint64_t k = 0; k < changed.samples(); ++k) b.push_back(rig.step());
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  ASSERT_EQ(a.size(), b.size());
+  bool moved_later = false;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (b[k].t < 2.0) {
+      ASSERT_EQ(a[k].p1, b[k].p1) << b[k].t;
+      ASSERT_EQ(a[k].x_true, b[k].x_true) << b[k].t;
+    } else if (b[k].t == 2.0) {
+      // Same plant state, the offset on the reading (within the 12-bit quantisation).
+      EXPECT_EQ(a[k].p1_true, b[k].p1_true);
+      EXPECT_NEAR(b[k].p1 - a[k].p1, 2e5, 6e3);
+    } else {
+      moved_later |= a[k].x_true != b[k].x_true;  // the friction acts
+    }
+  }
+  EXPECT_TRUE(moved_later);
+  rig.reset();
+  EXPECT_EQ(rig.step().p1, a[0].p1);
+  const auto meta = capture_metadata(changed);
+  bool named = false;
+  for (const auto& [key, value] : meta) {
+    if (key == "effect_change") {
+      named = true;
+      EXPECT_NE(value.find("t_s=2"), std::string::npos) << value;
+      EXPECT_NE(value.find("sensor_offset"), std::string::npos) << value;
+    }
+  }
+  EXPECT_TRUE(named);
+}
+
 TEST(BatchSimulation, WritesTheCaptureColumnsAndMetadata) {
   Scenario s = everything_on();
   s.params.beta = 6e8;

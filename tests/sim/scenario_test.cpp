@@ -2,6 +2,7 @@
 // with file:line:column and the field's path; presets carry MODEL.md's experiment table.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -295,6 +296,101 @@ TEST(Effects, EnableByNameUsesMODELsParameterNames) {
     EXPECT_EQ(one.describe()[0].name, name);
     one.disable(name);
     EXPECT_TRUE(one.describe().empty()) << name;
+  }
+}
+
+}  // namespace
+}  // namespace leakmon::sim
+
+namespace leakmon::sim {
+namespace {
+
+// Correlation of x with the reference after the first second, and the largest chamber pressure.
+struct Tracking {
+  double correlation = 0.0;
+  double max_pressure = 0.0;
+};
+Tracking tracking_of(const capture::Capture& capture) {
+  const auto& x = capture.column("x");
+  const auto& r = capture.column("xref");
+  const auto& p1 = capture.column("p1");
+  const auto& p2 = capture.column("p2");
+  double sx = 0, sr = 0, sxx = 0, srr = 0, sxr = 0, n = 0;
+  Tracking out;
+  for (std::size_t i = 500; i < x.size(); ++i) {
+    sx += x[i];
+    sr += r[i];
+    sxx += x[i] * x[i];
+    srr += r[i] * r[i];
+    sxr += x[i] * r[i];
+    n += 1.0;
+    out.max_pressure = std::max({out.max_pressure, p1[i], p2[i]});
+  }
+  out.correlation = (sxr - sx * sr / n) / std::sqrt((sxx - sx * sx / n) * (srr - sr * sr / n));
+  return out;
+}
+
+// The shipped other-rig examples run their rig with the paper's controller and track its steps,
+// their transducers ranged for their supply (a 21 MPa supply would saturate MODEL.md's 20.7 MPa).
+TEST(OtherRigScenarios, TheExamplesRunAndTrack) {
+  for (const char* file : {"other-rig-50mm-21mpa.yaml", "other-rig-soft-heavy.yaml"}) {
+    const Scenario s = load_scenario(test::source_dir() + "/sim/scenarios/" + file);
+    EXPECT_FALSE(s.rig.nominal()) << file;
+    EXPECT_TRUE(s.warnings.empty()) << file << ": " << s.warnings.front();
+    EXPECT_GT(s.sensors.pressure_full_scale, 1.15 * s.params.ps) << file;
+    const capture::Capture capture = simulate(s);
+    const Tracking t = tracking_of(capture);
+    EXPECT_GT(t.correlation, 0.95) << file;
+    EXPECT_LT(t.max_pressure, s.sensors.pressure_full_scale) << file;
+  }
+  const Scenario high =
+      load_scenario(test::source_dir() + "/sim/scenarios/other-rig-50mm-21mpa.yaml");
+  EXPECT_EQ(high.sensors.pressure_full_scale, 25e6);
+}
+
+TEST(OtherRigScenarios, ThePressureRangeFollowsTheStatedSupplyUnlessSensorsSayOtherwise) {
+  EXPECT_EQ(
+      parse_scenario("rig: {supply_pressure: 28.0e6}\n", "a.yaml").sensors.pressure_full_scale,
+      35e6);
+  EXPECT_EQ(parse_scenario(
+                "rig: {supply_pressure: 28.0e6}\nsensors: {pressure_full_scale: 4.0e7}\n", "b.yaml")
+                .sensors.pressure_full_scale,
+            40e6);
+  // The paper's supply stated keeps the paper's transducers, and so its capture.
+  const Scenario stated =
+      parse_scenario("duration_s: 2\nrig: {supply_pressure: 17.2e6}\n", "c.yaml");
+  EXPECT_EQ(stated.sensors.pressure_full_scale, SensorSettings{}.pressure_full_scale);
+  Scenario paper = preset("healthy", 1);
+  paper.duration_s = 2.0;
+  EXPECT_EQ(simulate(stated).values, simulate(paper).values);
+  // A rig that leaves the supply unsaid keeps them too.
+  EXPECT_EQ(parse_scenario("rig: {bore: 0.05}\n", "d.yaml").sensors.pressure_full_scale, 20.7e6);
+}
+
+// MODEL.md "Other rigs": steps beyond the end stops, or a load needing more force than the rig
+// can make, are errors at the reference's amplitude (or the rig); a load above half of it warns.
+TEST(OtherRigScenarios, AReferenceTheRigCannotFollowIsAnErrorOrAWarning) {
+  std::string e = error_of("rig: {stroke: 0.08}\n");
+  EXPECT_NE(e.find("bad.yaml:1:6"), std::string::npos) << e;
+  EXPECT_NE(e.find("end stops"), std::string::npos) << e;
+  e = error_of("rig: {stroke: 0.5}\nreference: {amp_min: 0.1, amp_max: 0.3}\n");
+  EXPECT_NE(e.find("bad.yaml:2:36"), std::string::npos) << e;
+  // 500 kN/m x 50 mm = 25 kN against 6.3e-4 m^2 x 17.1 MPa = 10.8 kN.
+  e = error_of("rig: {load_stiffness: 500.0e3}\n");
+  EXPECT_NE(e.find("cannot follow"), std::string::npos) << e;
+  EXPECT_NE(e.find("25 kN"), std::string::npos) << e;
+  // 130 kN/m: 6.5 kN, 60 % of it.
+  const Scenario warned = parse_scenario("rig: {load_stiffness: 130.0e3}\n", "warn.yaml");
+  ASSERT_EQ(warned.warnings.size(), 1u);
+  EXPECT_EQ(warned.warnings.front().rfind("warn.yaml:1:6: ", 0), 0u) << warned.warnings.front();
+  EXPECT_NE(warned.warnings.front().find("60 %"), std::string::npos) << warned.warnings.front();
+  // The paper's rig and its steps: nothing to say.
+  EXPECT_TRUE(parse_scenario("name: paper\n", "paper.yaml").warnings.empty());
+  for (const auto& entry :
+       std::filesystem::directory_iterator(test::source_dir() + "/sim/scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const Scenario s = load_scenario(entry.path().string());
+    EXPECT_TRUE(s.warnings.empty()) << entry.path() << ": " << s.warnings.front();
   }
 }
 

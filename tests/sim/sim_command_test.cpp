@@ -43,6 +43,34 @@ TEST(SimCommand, PresetWritesTheCaptureWithMetadata) {
   EXPECT_EQ(capture.sample_rate_hz(), 500.0);
 }
 
+// Issue 25: `sim --preset paper-fig13 --duration 120` ended silently before the preset's leak
+// at 300 s. The run now says what the capture holds, and warns of what starts after its end.
+TEST(SimCommand, SaysWhatTheRunHoldsAndWarnsOfALeakAfterItsEnd) {
+  const std::string dir = test::scratch_dir("sim_command_summary");
+  const Result short_run = run("--preset paper-fig13 --duration 2 --out " + dir + "/short.csv");
+  ASSERT_EQ(short_run.exit_code, 0) << short_run.output;
+  for (const char* part :
+       {"preset paper-fig13, seed 1, basic controller: 2 s at 500 Hz (1000 rows)",
+        "internal leak 0.13 l/min/MPa from t = 300 s", "short.csv"}) {
+    EXPECT_NE(short_run.output.find(part), std::string::npos) << part << "\n" << short_run.output;
+  }
+  EXPECT_NE(short_run.output.find("warning: internal_leakage starts at t = 300 s, after the run "
+                                  "ends at t = 2 s: the capture holds no leak"),
+            std::string::npos)
+      << short_run.output;
+
+  // A run that reaches its leak is summarised without a warning.
+  const Result full = run("--preset paper-fig10 --duration 16 --out " + dir + "/full.csv");
+  ASSERT_EQ(full.exit_code, 0) << full.output;
+  EXPECT_NE(full.output.find("internal leak 0.12 l/min/MPa from t = 15 s"), std::string::npos)
+      << full.output;
+  EXPECT_EQ(full.output.find("warning"), std::string::npos) << full.output;
+
+  const Result healthy = run("--preset healthy --duration 1 --out " + dir + "/healthy.csv");
+  ASSERT_EQ(healthy.exit_code, 0) << healthy.output;
+  EXPECT_NE(healthy.output.find("no effects (healthy)"), std::string::npos) << healthy.output;
+}
+
 TEST(SimCommand, ScenarioFileRunsAndBadFilesFailWithTheirLocation) {
   const std::string dir = test::scratch_dir("sim_command_scenario");
   const Result ok =

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <string>
 #include <variant>
@@ -16,6 +17,7 @@
 #include "study/evaluation_runner.hpp"
 #include "study/evaluation_summary.hpp"
 #include "study/evaluation_writers.hpp"
+#include "tests/model/test_seed.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon::study {
@@ -92,6 +94,185 @@ TEST(CaseGeneration, PlansHealthyThenLeakRunsAndReproducesTheSeed) {
   EXPECT_EQ(one.scenario.seed, 1234u);
   EXPECT_DOUBLE_EQ(one.scenario.duration_s, one.onset + 75.0);
   EXPECT_EQ(one.scenario.controller, sim::ControllerKind::fault_tolerant);  // odd id
+}
+
+// The lengths and values of MODEL.md's "Test programs" table, for checking the draws.
+struct PhaseRange {
+  double minutes_lo, minutes_hi;
+};
+PhaseRange typical_minutes(sim::PhaseKind kind) {
+  switch (kind) {
+    case sim::PhaseKind::hold:
+      return {1.0, 10.0};
+    case sim::PhaseKind::sweep:
+      return {1.0, 5.0};
+    default:
+      return {2.0, 10.0};
+  }
+}
+
+void expect_typical_values(const sim::Phase& phase) {
+  switch (phase.kind) {
+    case sim::PhaseKind::steps:
+      break;
+    case sim::PhaseKind::hold:
+      EXPECT_LE(std::abs(phase.X), 0.05);
+      break;
+    case sim::PhaseKind::sine:
+      EXPECT_GE(phase.F, 0.2);
+      EXPECT_LE(phase.F, 3.0);
+      EXPECT_GE(phase.A, 0.005);
+      EXPECT_LE(phase.A, 0.04);
+      break;
+    case sim::PhaseKind::sweep:
+      EXPECT_GE(phase.F0, 0.1);
+      EXPECT_LE(phase.F0, 0.5);
+      EXPECT_GE(phase.F1, 1.5);
+      EXPECT_LE(phase.F1, 4.0);
+      EXPECT_GE(phase.A, 0.005);
+      EXPECT_LE(phase.A, 0.03);
+      break;
+    case sim::PhaseKind::triangle:
+      EXPECT_GE(phase.P, 1.0);
+      EXPECT_LE(phase.P, 8.0);
+      EXPECT_GE(phase.A, 0.01);
+      EXPECT_LE(phase.A, 0.045);
+      break;
+  }
+}
+
+// programs and wear: every phase kind gets its leaks, the draws follow MODEL.md's table, the
+// truth marks holds too close to the spring's rest as not judgeable, and a master seed
+// reproduces every run. A fresh seed each run (printed).
+TEST(CaseGeneration, ProgramsAndWearFollowTheModelAndReproduceTheSeed) {
+  EvaluationOptions options = short_options(test::model_test_seed("programs and wear"));
+  options.conditions = {"programs", "wear"};
+  options.healthy_runs = 20;
+  options.runs_per_leak = 10;  // per size 5 under programs, 5 wear runs
+  options.leak_sizes = {1e-12, 2e-12};
+  options.time_scale = 0.5;
+  const auto runs = draw_runs(options);
+  ASSERT_EQ(runs.size(), 40u);
+  std::map<sim::PhaseKind, int> leaks_in;
+  int starts_with_hold = 0, programs = 0, not_judgeable = 0, wear_runs = 0;
+  for (const RunSpec& run : runs) {
+    SCOPED_TRACE("run " + std::to_string(run.id));
+    const bool program = run.condition.operating == "programs";
+    if (!program) {
+      // wear: the steps rig with the cooler's cycle and `temp`; wear in leak runs only.
+      EXPECT_TRUE(run.phases.empty());
+      EXPECT_TRUE(run.scenario.program.empty());
+      EXPECT_TRUE(run.scenario.record.temp);
+      ASSERT_TRUE(run.scenario.conditions.temperature.has_value());
+      EXPECT_EQ(run.scenario.conditions.temperature->kind, sim::TemperatureProfile::Kind::cooler);
+      if (run.leak == 0.0) {
+        EXPECT_FALSE(run.wear_run());
+        continue;
+      }
+      ++wear_runs;
+      ASSERT_TRUE(run.wear_run());
+      EXPECT_GE(run.leak, 1e-12);
+      EXPECT_LE(run.leak, 5e-12);
+      EXPECT_GE(run.wear_seconds, 600.0 * options.time_scale);
+      EXPECT_LE(run.wear_seconds, 14400.0 * options.time_scale);
+      ASSERT_TRUE(run.scenario.effects.internal_leakage.has_value());
+      const sim::InternalLeakage& leak = *run.scenario.effects.internal_leakage;
+      EXPECT_EQ(leak.C_L, run.leak);
+      EXPECT_EQ(leak.onset_s, run.onset);
+      EXPECT_EQ(leak.ramp_s, run.wear_seconds);
+      EXPECT_DOUBLE_EQ(run.scenario.duration_s,
+                       run.onset + run.wear_seconds + options.after_onset_seconds);
+      EXPECT_DOUBLE_EQ(run.leak_at(run.onset + 0.5 * run.wear_seconds), 0.5 * run.leak);
+      EXPECT_EQ(run.leak_at(run.onset - 1.0), 0.0);
+      EXPECT_EQ(run.leak_at(run.scenario.duration_s), run.leak);
+      continue;
+    }
+    ++programs;
+    const auto& p = run.scenario.program;
+    ASSERT_GE(p.size(), 3u);
+    ASSERT_LE(p.size(), 8u);
+    ASSERT_EQ(run.phases.size(), p.size());
+    EXPECT_FALSE(run.scenario.record.temp);  // the stationary rig
+    starts_with_hold += p.front().kind == sim::PhaseKind::hold ? 1 : 0;
+    double start = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      SCOPED_TRACE(p[i].notation());
+      expect_typical_values(p[i]);
+      const PhaseRange range = typical_minutes(p[i].kind);
+      EXPECT_GE(p[i].duration_s, 60.0 * range.minutes_lo * options.time_scale - 1e-9);
+      // Only the phase a leak opens in may be lengthened (to open 20 s after learning).
+      if (static_cast<int>(i) != run.leak_phase) {
+        EXPECT_LE(p[i].duration_s, 60.0 * range.minutes_hi * options.time_scale + 1e-9);
+      }
+      const ProgramPhase& truth = run.phases[i];
+      EXPECT_EQ(truth.kind, p[i].kind);
+      EXPECT_EQ(truth.notation, p[i].notation());
+      EXPECT_DOUBLE_EQ(truth.start, std::min(start, run.scenario.duration_s));
+      start += p[i].duration_s;
+      const double load = std::abs(run.scenario.params.K_s * p[i].X) / run.scenario.params.A();
+      EXPECT_EQ(truth.judgeable, p[i].kind != sim::PhaseKind::hold || load >= 1e6);
+      not_judgeable += truth.judgeable ? 0 : 1;
+    }
+    EXPECT_EQ(run.phases.back().end, run.scenario.duration_s);
+    if (run.leak == 0.0) {
+      // A healthy run lasts as long as its program.
+      EXPECT_EQ(run.leak_phase, -1);
+      EXPECT_DOUBLE_EQ(run.scenario.duration_s, start);
+      EXPECT_FALSE(run.scenario.effects.internal_leakage.has_value());
+      continue;
+    }
+    // The leak opens inside the planned kind's phase, neither the first nor the last, 20 s or
+    // more after learning; a run goes on for the window after the onset, and past the next
+    // phase's start plus the window when the phase cannot be judged.
+    const auto planned = std::get<LeakCondition>(run.condition.kind).phase;
+    ASSERT_TRUE(planned.has_value());
+    ASSERT_GE(run.leak_phase, 1);
+    ASSERT_LE(run.leak_phase, static_cast<int>(p.size()) - 2);
+    const ProgramPhase& opened_in = run.phases[static_cast<std::size_t>(run.leak_phase)];
+    EXPECT_EQ(opened_in.kind, *planned);
+    EXPECT_EQ(run.phase_at(run.onset), run.leak_phase);
+    EXPECT_GE(run.onset, run.monitor_from + 20.0);
+    EXPECT_GE(run.onset, opened_in.start);
+    EXPECT_LT(run.onset, opened_in.end);
+    ASSERT_TRUE(run.scenario.effects.internal_leakage.has_value());
+    EXPECT_EQ(run.scenario.effects.internal_leakage->onset_s, run.onset);
+    EXPECT_EQ(run.scenario.effects.internal_leakage->ramp_s, 0.0);
+    EXPECT_GE(run.scenario.duration_s, run.onset + options.after_onset_seconds - 1e-9);
+    if (opened_in.judgeable) {
+      EXPECT_EQ(run.detection_deadline(60.0), run.onset + 60.0);
+    } else {
+      EXPECT_EQ(run.detection_deadline(60.0), opened_in.end + 60.0);
+      EXPECT_GE(run.scenario.duration_s, opened_in.end + 60.0);
+    }
+    ++leaks_in[opened_in.kind];
+  }
+  EXPECT_EQ(programs, 20);
+  EXPECT_EQ(wear_runs, 10);
+  // Every kind twice (the kinds in turn over the program leak runs of both sizes).
+  for (const sim::PhaseKind kind : sim::kPhaseKinds) {
+    EXPECT_EQ(leaks_in[kind], 2) << sim::to_string(kind);
+  }
+  // Half of the programs start with a hold (20 programs: all or none has probability 2e-6).
+  EXPECT_GT(starts_with_hold, 0);
+  EXPECT_LT(starts_with_hold, programs);
+  std::printf("%d of %d programs start with a hold; %d holds not judgeable\n", starts_with_hold,
+              programs, not_judgeable);
+
+  // The master seed reproduces every run; another seed draws other programs.
+  const auto again = draw_runs(options);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    ASSERT_EQ(again[i].scenario.program.size(), runs[i].scenario.program.size());
+    for (std::size_t k = 0; k < runs[i].scenario.program.size(); ++k) {
+      EXPECT_EQ(again[i].scenario.program[k].notation(), runs[i].scenario.program[k].notation());
+      EXPECT_EQ(again[i].scenario.program[k].duration_s, runs[i].scenario.program[k].duration_s);
+    }
+    EXPECT_EQ(again[i].onset, runs[i].onset);
+    EXPECT_EQ(again[i].scenario.duration_s, runs[i].scenario.duration_s);
+    EXPECT_EQ(again[i].leak, runs[i].leak);
+  }
+  EvaluationOptions other = options;
+  other.seed = options.seed + 1;
+  EXPECT_NE(draw_runs(other)[0].scenario.duration_s, runs[0].scenario.duration_s);
 }
 
 // One healthy and one large-leak run through the runner, the aggregation and the writers.

@@ -33,6 +33,18 @@ function fmt(value, digits, unit) {
 // JSON null (the daemon has no value yet) stays null through a change of unit.
 function scaled(value, divisor) { return typeof value === "number" ? value / divisor : null; }
 
+// The newest finite value of a trend column, or null. The status's own value is null while the
+// newest wavelet window holds a gap (a missed cycle), which on a loaded machine is much of the
+// time: the tile then shows what the chart shows, the newest value there is.
+function newestFinite(column) {
+  for (let i = column.length - 1; i >= 0; --i) {
+    if (Number.isFinite(column[i])) return column[i];
+  }
+  return null;
+}
+
+function current(value, column) { return Number.isFinite(value) ? value : newestFinite(column); }
+
 function stateClass(state) {
   if (state === "normal") return "ok";
   if (state === "active_acknowledged") return "warn";
@@ -179,13 +191,15 @@ function updateActuator(a) {
   entry.suspended.hidden = !a.suspended;
   entry.blind.hidden = !a.detection_blind;
   entry.ack.disabled = a.alarm_state === "normal";
-  tiles.index.value.textContent =
-    fmt(scaled(a.index_p1_pa, 1e3), 2) + " / " + fmt(scaled(a.index_p2_pa, 1e3), 2);
+  if (a.trend) appendColumns(entry.data, a.trend, TREND_COLUMNS);
+  const data = entry.data;
+  tiles.index.value.textContent = fmt(scaled(current(a.index_p1_pa, data.index_p1_pa), 1e3), 2) +
+    " / " + fmt(scaled(current(a.index_p2_pa, data.index_p2_pa), 1e3), 2);
   tiles.score.value.textContent = fmt(a.score, 3) + " / " + fmt(a.raise_threshold, 3);
   tiles.leak.value.textContent = Number.isFinite(a.leak_lpm_per_mpa)
     ? fmt(a.leak_lpm_per_mpa, 3) + " ± " + fmt(a.leak_lpm_per_mpa_ci95, 3) : "–";
-  tiles.pressure.value.textContent =
-    fmt(scaled(a.p1_pa, 1e6), 2) + " / " + fmt(scaled(a.p2_pa, 1e6), 2);
+  tiles.pressure.value.textContent = fmt(scaled(current(a.p1_pa, data.p1_pa), 1e6), 2) + " / " +
+    fmt(scaled(current(a.p2_pa, data.p2_pa), 1e6), 2);
   tiles.temperature.value.textContent =
     a.oil_temperature_c === null ? "not acquired" : fmt(a.oil_temperature_c, 1);
   tiles.decisions.value.textContent = String(a.decisions);
@@ -199,7 +213,6 @@ function updateActuator(a) {
     sensors.appendChild(document.createTextNode(" "));
   }
   if (a.trend) {
-    appendColumns(entry.data, a.trend, TREND_COLUMNS);
     card.dataset.points = String(entry.data.time.length);
     const range = windowRange(entry.data.time);
     entry.charts.forEach((c, i) => {
@@ -285,6 +298,34 @@ function eventDetail(e) {
   return parts.join(", ");
 }
 
+// Events that repeat while nothing else happens (a loaded machine's overruns, once a second at
+// most) fold into the newest row with a count, so that they cannot push an alarm out of sight.
+const FOLDED_EVENTS = new Set(["overrun"]);
+
+function eventRow(e, seq) {
+  const row = el("tr", e.event);
+  row.dataset.seq = String(seq);
+  row.dataset.count = "1";
+  const when = e.time ? new Date(e.time).toLocaleTimeString() : "";
+  for (const text of [when, e.event, e.actuator || "", e.alarm || "", eventDetail(e)]) {
+    row.appendChild(el("td", null, text));
+  }
+  return row;
+}
+
+// Folds `e` into `row` (the newest row, of the same kind and channel): newest time and detail,
+// the count beside the event's name, the first time in the row's tooltip.
+function foldInto(row, e, seq) {
+  const count = Number(row.dataset.count) + 1;
+  row.dataset.count = String(count);
+  row.dataset.seq = String(seq);
+  const cells = row.cells;
+  if (!row.title) row.title = "first at " + cells[0].textContent;
+  cells[0].textContent = e.time ? new Date(e.time).toLocaleTimeString() : "";
+  cells[1].textContent = e.event + " ×" + count;
+  cells[4].textContent = eventDetail(e);
+}
+
 async function pollEvents() {
   try {
     const response = await fetch("api/events?after=" + view.eventsAfter, { cache: "no-store" });
@@ -293,13 +334,15 @@ async function pollEvents() {
     const body = $("events").tBodies[0];
     for (const item of answer.events) {
       const e = item.event;
-      const row = el("tr", e.event);
-      row.dataset.seq = String(item.seq);
-      const when = e.time ? new Date(e.time).toLocaleTimeString() : "";
-      for (const text of [when, e.event, e.actuator || "", e.alarm || "", eventDetail(e)]) {
-        row.appendChild(el("td", null, text));
+      const newest = body.rows[0];
+      if (FOLDED_EVENTS.has(e.event) && newest && newest.classList.contains(e.event) &&
+          newest.dataset.channel === (e.channel || "")) {
+        foldInto(newest, e, item.seq);
+      } else {
+        const row = eventRow(e, item.seq);
+        row.dataset.channel = e.channel || "";
+        body.insertBefore(row, body.firstChild);
       }
-      body.insertBefore(row, body.firstChild);
       view.eventsAfter = Math.max(view.eventsAfter, item.seq);
     }
     while (body.rows.length > MAX_EVENT_ROWS) body.deleteRow(body.rows.length - 1);

@@ -148,6 +148,48 @@ TEST(ModbusConfig, ConnectionErrorsNameFileLineColumnAndField) {
   expect_error("name: daq\ntype: can\nhost: x\n" + channels, "drivers.yaml:2:", "'modbus'");
 }
 
+// Issue 25: `host: 127.0.0.300` passed check-config and failed only when connecting.
+TEST(ModbusConfig, TheHostIsAnAddressOrAName) {
+  const std::string channels = "channels:\n  - {name: p1, address: 0}\n";
+  expect_error("name: daq\nhost: 127.0.0.300\n" + channels, "drivers.yaml:2:7: host",
+               "'127.0.0.300' is not an IPv4 address");
+  expect_error("name: daq\nhost: 192.168.10\n" + channels, "drivers.yaml:2:7: host",
+               "not an IPv4 address");
+  expect_error("name: daq\nhost: plc_1.lan\n" + channels, "drivers.yaml:2:7: host",
+               "neither an IP address nor a host name");
+  expect_error("name: daq\nhost: 'fe80::1::2'\n" + channels, "drivers.yaml:2:7: host",
+               "not an IPv6 address");
+  expect_error("name: daq\nhost: ''\n" + channels, "drivers.yaml:2:7: host", "must not be empty");
+  for (const char* good : {"10.0.0.1", "plc-1.plant.lan", "::1", "localhost"}) {
+    EXPECT_EQ(parse(std::string("name: daq\nhost: '") + good + "'\n" + channels).tcp->host, good);
+  }
+}
+
+// Two channels on the same registers are legal (a value and its halves) but usually a copied
+// entry whose address was not changed: a warning naming both, with file:line:column.
+TEST(ModbusConfig, OverlappingRegistersAreAWarning) {
+  const auto config = parse(kTcp +
+                            "channels:\n"
+                            "  - {name: p1, register: input, address: 0, data_type: FLOAT32}\n"
+                            "  - {name: p2, register: input, address: 1, data_type: FLOAT32}\n"
+                            "  - {name: x, register: holding, address: 0}\n"
+                            "  - {name: u, register: input, address: 2, unit_id: 2}\n"
+                            "  - {name: v, register: input, address: 2}\n");
+  ASSERT_EQ(config.warnings.size(), 2u);
+  EXPECT_EQ(config.warnings[0],
+            "drivers.yaml:7:42: channels[1].address: channel 'p2' reads registers 1..2 of unit 1, "
+            "which channel 'p1' (drivers.yaml:6:42) also reads");
+  EXPECT_NE(config.warnings[1].find("drivers.yaml:10:"), std::string::npos) << config.warnings[1];
+  EXPECT_NE(config.warnings[1].find("channel 'v' reads registers 2..2 of unit 1, which channel "
+                                    "'p2'"),
+            std::string::npos)
+      << config.warnings[1];
+  // Another register space or another unit is no overlap; neither are adjacent values.
+  EXPECT_TRUE(parse(kTcp + "channels:\n  - {name: a, address: 0, data_type: FLOAT32}\n"
+                           "  - {name: b, address: 2, data_type: FLOAT32}\n")
+                  .warnings.empty());
+}
+
 TEST(ModbusConfig, TheFactoryValidatesToo) {
   const auto node = config::ConfigNode::load_string(
       kTcp + "channels:\n  - {name: p1, address: 0, data_type: FLOAT}\n", "drivers.yaml");

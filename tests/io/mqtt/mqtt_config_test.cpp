@@ -2,6 +2,8 @@
 // with the field's path (what `leakmon check-config` prints).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 #include "io/mqtt/mqtt_output.hpp"
@@ -91,6 +93,70 @@ TEST(MqttConfig, MistakesNameFileLineAndColumn) {
   EXPECT_NE(error_of("{name: f, type: mqtt, topic: a, queue: {max_events: 0}}").find("max_events"),
             std::string::npos);
   EXPECT_NE(error_of("{name: f, type: mqtt, topic: a, features_hz: 100}").find("features_hz"),
+            std::string::npos);
+}
+
+// Issue 25: the password kept out of the configuration, in a root-only file or a systemd
+// credential (LoadCredential=NAME:PATH puts it at $CREDENTIALS_DIRECTORY/NAME).
+TEST(MqttConfig, PasswordFromAFileOrASystemdCredential) {
+  const std::string dir = test::scratch_dir("mqtt_config_password_file");
+  const std::string config = dir + "/leakmon.yaml";
+  std::ofstream(dir + "/mqtt-password") << "s3cret: with spaces\n";
+  const auto in_file = [&](const std::string& yaml) {
+    return parse_mqtt_settings(config::ConfigNode::load_string(yaml, config));
+  };
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  // Relative: beside the configuration (check-config by hand reads what the unit's
+  // LoadCredential reads), one trailing newline dropped.
+  EXPECT_EQ(in_file("{name: f, type: mqtt, topic: a, username: u, password_file: mqtt-password}")
+                .password,
+            "s3cret: with spaces");
+  EXPECT_EQ(in_file("{name: f, type: mqtt, topic: a, username: u, password_file: " + dir +
+                    "/mqtt-password}")
+                .password,
+            "s3cret: with spaces");
+  // Under systemd with credentials: the relative name is the credential's.
+  const std::string credentials = dir + "/credentials";
+  std::filesystem::create_directories(credentials);
+  std::ofstream(credentials + "/mqtt-password") << "from-systemd";
+  ::setenv("CREDENTIALS_DIRECTORY", credentials.c_str(), 1);
+  EXPECT_EQ(in_file("{name: f, type: mqtt, topic: a, username: u, password_file: mqtt-password}")
+                .password,
+            "from-systemd");
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+
+  // The inline password stays accepted; not both; a missing or empty file names its field.
+  EXPECT_EQ(parse("{name: f, type: mqtt, topic: a, username: u, password: p}").password, "p");
+  const std::string both =
+      error_of("name: f\ntype: mqtt\ntopic: a\nusername: u\npassword: p\npassword_file: /x\n");
+  EXPECT_NE(both.find("leakmon.yaml:5:11: password: give either password or password_file"),
+            std::string::npos)
+      << both;
+  try {
+    in_file("name: f\ntype: mqtt\ntopic: a\nusername: u\npassword_file: nowhere\n");
+    ADD_FAILURE() << "a missing password file was accepted";
+  } catch (const config::ConfigError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(config + ":5:16: password_file: cannot read '" + dir + "/nowhere'"),
+              std::string::npos)
+        << message;
+  }
+  std::ofstream(dir + "/empty");
+  EXPECT_THROW(in_file("{name: f, type: mqtt, topic: a, username: u, password_file: empty}"),
+               config::ConfigError);
+  EXPECT_NE(error_of("{name: f, type: mqtt, topic: a, password_file: /x}").find("needs a username"),
+            std::string::npos);
+}
+
+TEST(MqttConfig, TheBrokerHostIsAnAddressOrAName) {
+  EXPECT_EQ(parse("{name: f, type: mqtt, topic: a, host: broker.plant-a.lan}").host,
+            "broker.plant-a.lan");
+  EXPECT_EQ(parse("{name: f, type: mqtt, topic: a, host: '::1'}").host, "::1");
+  const std::string bad = error_of("name: f\ntype: mqtt\ntopic: a\nhost: 10.0.0.256\n");
+  EXPECT_NE(bad.find("leakmon.yaml:4:7: host: '10.0.0.256' is not an IPv4 address"),
+            std::string::npos)
+      << bad;
+  EXPECT_NE(error_of("{name: f, type: mqtt, topic: a, host: 'broker lan'}").find("host name"),
             std::string::npos);
 }
 

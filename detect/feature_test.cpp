@@ -1,0 +1,369 @@
+#include "detect/feature_test.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "detect/least_squares.hpp"
+
+namespace leakmon::detect {
+
+namespace {
+
+// Load activity below this (1e-3 of supply per hop) counts as "still": keeps the log finite.
+constexpr double kActivityFloor = 1e-3;
+// A hop whose load moved less than this (of supply) is at rest for the supply estimate: there
+// p1 + p2 = ps + pt (MODEL.md).
+constexpr double kRestActivity = 2e-3;
+// Rest readings in a row far from the estimate that make a supply step (not one odd hop).
+constexpr std::size_t kSupplyStepHops = 10;
+// Judged blocks whose CUSUM increments can be taken back after a supply step seen through one
+// chamber: the step shows at the end of the first hold that fits neither cluster (holds last up
+// to 4 s, a ramp up to 5 s, and a few holds after the step may fit by chance), so within about
+// 20 s; the history covers 48 s.
+constexpr std::size_t kCusumHistoryBlocks = 60;
+
+SupplyTrackerOptions supply_options(const FeatureTestOptions& o, std::size_t block_hops) {
+  SupplyTrackerOptions s;
+  s.configured = o.rig.ps;
+  s.rule = SupplyTrackerOptions::StepRule::drift_from_anchor;
+  s.confirm_readings = kSupplyStepHops;
+  s.reading_seconds = o.block_seconds / static_cast<double>(block_hops);
+  return s;
+}
+
+DriftReferenceOptions drift_options(const FeatureTestOptions& o, const FeaturePhysics& physics) {
+  DriftReferenceOptions d;
+  d.guard_seconds = o.drift_guard_seconds;
+  d.window_seconds = o.drift_window_seconds;
+  d.keep_seconds =
+      o.drift_guard_seconds + o.drift_window_seconds + o.supply_settle_seconds + o.block_seconds;
+  d.block_seconds = o.block_seconds;
+  d.bound = -physics.design_shift;
+  d.shrink_slope = true;
+  d.slope_needs_full_window = true;
+  return d;
+}
+
+// The state's names of the regressors' coefficients and of the block being filled.
+constexpr std::array<std::string_view, 5> kCoefficientNames = {"constant", "load", "load_squared",
+                                                               "log_activity", "log_friction"};
+
+}  // namespace
+
+FeatureTest::FeatureTest(const FeatureTestOptions& options, const FeaturePhysics& physics,
+                         double hop_seconds)
+    : options_(options),
+      physics_(physics),
+      block_hops_(hops_in(options.block_seconds, hop_seconds)),
+      clock_(options.learning, hop_seconds),
+      one_chamber_(options.use_p1 != options.use_p2),
+      supply_(supply_options(options, block_hops_)),
+      cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds),
+             kCusumHistoryBlocks),
+      drift_(drift_options(options, physics)) {
+  learned_.reserve(clock_.learn_hops() / block_hops_ + 1);
+  coefficients_[4] = physics.temperature_prior;
+}
+
+void FeatureTest::reset() {
+  clock_.reset();
+  learned_.clear();
+  std::fill(std::begin(coefficients_), std::end(coefficients_), 0.0);
+  coefficients_[4] = physics_.temperature_prior;
+  block_sigma_ = kMissing;
+  block_hop_ = block_valid_ = 0;
+  sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
+  sum_log_friction_ = sum_log_supply_ = 0.0;
+  previous_load_ = previous_rough_load_ = last_expected_ = kMissing;
+  temperature_seen_ = false;
+  supply_.reset();
+  chamber_supply_.reset();
+  learned_supply_ = kMissing;
+  cusum_.reset();
+  drift_.clear();
+}
+
+void FeatureTest::resume_after_gap() {
+  drift_.clear();
+  supply_.resume_after_gap();
+  previous_load_ = previous_rough_load_ = kMissing;
+  chamber_supply_.resume_after_gap();
+  cusum_.forget_history();
+}
+
+// Load pressure p1 - p2 over supply; with one chamber, that chamber's departure from mid-supply
+// (the two chambers mirror each other around it at rest).
+double FeatureTest::load_of(const Observation& o, double ps) const {
+  const double pt = options_.rig.pt;
+  if (options_.use_p1 && options_.use_p2 && !std::isnan(o.p1) && !std::isnan(o.p2)) {
+    return (o.p1 - o.p2) / ps;
+  }
+  if (options_.use_p1 && !std::isnan(o.p1)) return (2.0 * o.p1 - ps - pt) / ps;
+  if (options_.use_p2 && !std::isnan(o.p2)) return (ps + pt - 2.0 * o.p2) / ps;
+  return kMissing;
+}
+
+// The supply from a `ps` observation, or from both chambers at rest; the configured value until
+// either exists. A step restarts the settling clock and the drift reference (the feature's
+// level before it belongs to another supply).
+double FeatureTest::supply_for(const Observation& o, double load) {
+  if (one_chamber_ && std::isnan(o.ps)) return supply_from_chamber(o, load);
+  double reading = kMissing;
+  const bool direct = !std::isnan(o.ps);
+  if (direct) {
+    reading = o.ps;
+  } else if (options_.use_p1 && options_.use_p2 && !std::isnan(o.p1) && !std::isnan(o.p2) &&
+             std::abs(load - previous_rough_load_) < kRestActivity) {
+    reading = o.p1 + o.p2 - options_.rig.pt;
+  }
+  previous_rough_load_ = load;
+  if (supply_.add(o.t, reading, direct)) drift_.clear();
+  return supply_.estimate();
+}
+
+// One chamber's hold levels (ChamberSupplyTracker). The blocks judged after a step began were
+// judged against the old supply: their CUSUM increments are taken back.
+double FeatureTest::supply_from_chamber(const Observation& o, double load) {
+  const double configured = options_.rig.ps;
+  const bool still = std::abs(load - previous_rough_load_) < kRestActivity;  // false with a NaN
+  previous_rough_load_ = load;
+  switch (chamber_supply_.add(o.t, options_.use_p1 ? o.p1 : o.p2, still)) {
+    case ChamberSupplyTracker::Event::step:
+      cusum_.take_back_after(chamber_supply_.step_time());
+      drift_.clear();
+      break;
+    case ChamberSupplyTracker::Event::estimated: {
+      // Nothing was judged while waiting; the step may have begun earlier than first thought.
+      cusum_.take_back_after(chamber_supply_.step_time());
+      // ps + pt = 2 mid: the supply moved by twice mid-supply's shift since learning.
+      const double learned = std::isnan(learned_supply_) ? configured : learned_supply_;
+      supply_.set_after_step(
+          o.t, std::max(learned + 2.0 * chamber_supply_.mid_shift(), 0.1 * configured));
+      drift_.clear();
+      break;
+    }
+    case ChamberSupplyTracker::Event::none:
+      break;
+  }
+  return supply_.estimate();
+}
+
+double FeatureTest::expected_feature(const Block& b) const {
+  return coefficients_[0] + coefficients_[1] * b.load + coefficients_[2] * b.load_squared +
+         coefficients_[3] * b.log_activity + coefficients_[4] * b.log_friction +
+         physics_.supply_exponent * b.log_supply;
+}
+
+// Adds one hop; true when a block completed with enough valid hops (then `completed` holds it).
+bool FeatureTest::add_to_block(const Observation& o, double temp, double feature, double load,
+                               double supply, Block& completed) {
+  const double activity = std::abs(load - previous_load_);
+  previous_load_ = load;
+  const bool settled = supply_.settled(o.t) && !chamber_supply_.awaiting();
+  const bool temperature_ok = !temperature_seen_ || !std::isnan(temp);
+  if (!std::isnan(feature) && !std::isnan(activity) && settled && temperature_ok) {
+    sum_feature_ += feature;
+    sum_load_ += load;
+    sum_load_squared_ += load * load;
+    sum_activity_ += activity;
+    sum_log_supply_ += std::log(supply);
+    // The viscous friction's share of the damping, b(T) = b (0.5 + 0.5 / r) (MODEL.md).
+    if (temperature_seen_) {
+      sum_log_friction_ -= std::log(sim::friction_factor(physics_.oil.ratio(temp)));
+    }
+    ++block_valid_;
+  }
+  if (++block_hop_ < block_hops_) return false;
+  const bool enough = 2 * block_valid_ >= block_hops_;
+  if (enough) {
+    const double n = static_cast<double>(block_valid_);
+    completed = {o.t,
+                 sum_feature_ / n,
+                 sum_load_ / n,
+                 sum_load_squared_ / n,
+                 std::log(sum_activity_ / n + kActivityFloor),
+                 sum_log_friction_ / n,
+                 sum_log_supply_ / n};
+  }
+  block_hop_ = block_valid_ = 0;
+  sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
+  sum_log_friction_ = sum_log_supply_ = 0.0;
+  return enough;
+}
+
+void FeatureTest::finish_learning() {
+  clock_.set_learned();
+  learned_supply_ = supply_.estimate();
+  if (one_chamber_) chamber_supply_.learn();
+  if (learned_.size() < 2 * kRegressors) return;  // too little data: never judges
+  const double exponent = physics_.supply_exponent;
+  auto response = [exponent](const Block& b) { return b.feature - exponent * b.log_supply; };
+  // First without the temperature: the spread that weighs the prior.
+  LeastSquares<4> plain;
+  for (const auto& b : learned_) {
+    plain.add(Eigen::Vector4d(1.0, b.load, b.load_squared, b.log_activity), response(b));
+  }
+  const Eigen::Vector4d beta4 = plain.solve();
+  for (int i = 0; i < 4; ++i) coefficients_[i] = beta4[i];
+  coefficients_[4] = physics_.temperature_prior;
+  if (temperature_seen_) {
+    // The prior on the temperature coefficient as one pseudo-observation of weight
+    // sigma^2 / sigma_prior^2: what the learning period's temperature range identifies
+    // outweighs it, a constant temperature leaves it in place.
+    using Vector5 = Eigen::Matrix<double, kRegressors, 1>;
+    LeastSquares<kRegressors> fit;
+    for (const auto& b : learned_) {
+      Vector5 x;
+      x << 1.0, b.load, b.load_squared, b.log_activity, b.log_friction;
+      fit.add(x, response(b));
+    }
+    // Neighbouring blocks share an operating point: the data's weight is that of its
+    // long-run (AR(1)) variance, not of as many independent blocks.
+    double sum_sq = 0.0, sum_lag = 0.0, previous = kMissing;
+    for (const auto& b : learned_) {
+      const double r =
+          response(b) - beta4.dot(Eigen::Vector4d(1.0, b.load, b.load_squared, b.log_activity));
+      sum_sq += r * r;
+      if (!std::isnan(previous)) sum_lag += r * previous;
+      previous = r;
+    }
+    const double rho = sum_sq > 0.0 ? lag_one_correlation(sum_lag, sum_sq) : 0.0;
+    const double weight = std::sqrt(plain.residual_variance(beta4) * (1.0 + rho) / (1.0 - rho)) /
+                          std::max(physics_.temperature_prior_sigma, 1e-9);
+    Vector5 prior = Vector5::Zero();
+    prior[4] = weight;
+    fit.add(prior, weight * physics_.temperature_prior);
+    const Vector5 beta = fit.solve();
+    for (int i = 0; i < kRegressors; ++i) coefficients_[i] = beta[i];
+  }
+  double sum_sq = 0.0, sum_lag = 0.0, previous = kMissing;
+  for (const auto& b : learned_) {
+    const double r = b.feature - expected_feature(b);
+    drift_.add(b.t, r);
+    sum_sq += r * r;
+    if (!std::isnan(previous)) sum_lag += r * previous;
+    previous = r;
+  }
+  const auto n = learned_.size();
+  const double sigma = std::sqrt(sum_sq / static_cast<double>(n - kRegressors));
+  block_sigma_ = cusum_block_sigma(sigma, n, lag_one_correlation(sum_lag, sum_sq));
+}
+
+double FeatureTest::anchored_until() const {
+  return supply_.step_time() + options_.supply_settle_seconds;
+}
+
+FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
+  Verdict verdict;
+  const bool past_settling = clock_.count_hop();
+  if (!clock_.learned()) verdict.learning_hops_left = clock_.hops_left();
+  if (!past_settling) return verdict;
+  const double temp = physics_.uses_temperature ? o.temp : kMissing;
+  if (!std::isnan(temp)) temperature_seen_ = true;
+
+  const double rough_load = load_of(o, options_.rig.ps);
+  const double supply = supply_for(o, rough_load);
+  Block block{};
+  const bool completed = add_to_block(o, temp, feature, load_of(o, supply), supply, block);
+  if (!clock_.learned()) {
+    if (completed) learned_.push_back(block);  // capacity reserved: never reallocates
+    if (clock_.period_over()) finish_learning();
+    return verdict;
+  }
+  verdict.learning = false;
+  if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) return verdict;
+  if (completed && !chamber_supply_.awaiting()) {
+    const double residual = block.feature - expected_feature(block);
+    const double reference =
+        drift_.reference(block.t, block_sigma_, temperature_seen_, anchored_until());
+    last_expected_ = expected_feature(block) + reference;
+    const double step_time = supply_.step_time();
+    const bool anchoring =
+        !std::isnan(step_time) && block.t - step_time < options_.supply_settle_seconds;
+    if (anchoring) {
+      drift_.add(block.t, residual);
+    } else {
+      // Log-likelihood ratio of "the mean residual is design_shift" against "null_shift", per
+      // block.
+      const double null_shift = physics_.null_shift / block_sigma_;
+      const double shift = physics_.design_shift / block_sigma_;  // more negative
+      const double z = (residual - reference) / block_sigma_;
+      cusum_.add(block.t, (shift - null_shift) * (z - (shift + null_shift) / 2.0));
+      // Blocks under suspicion stay out of the reference: a leak is never learned as drift.
+      if (cusum_.normalised() < 0.5) drift_.add(block.t, residual);
+    }
+  }
+  verdict.expected = last_expected_;
+  verdict.score = cusum_.normalised();
+  return verdict;
+}
+
+void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
+  const auto key = [&](std::string_view name) { return state_key(prefix, name); };
+  clock_.save(state, key("learning"));
+  put_records(state, key("learned"), std::span<const Block>(learned_), kBlockFields);
+  for (int i = 0; i < kRegressors; ++i) {
+    state.put(key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])),
+              coefficients_[i]);
+  }
+  state.put(key("block_sigma"), block_sigma_);
+  state.put_count(key("block.hops"), block_hop_);
+  state.put_count(key("block.valid"), block_valid_);
+  state.put(key("block.sum_feature"), sum_feature_);
+  state.put(key("block.sum_load"), sum_load_);
+  state.put(key("block.sum_load_squared"), sum_load_squared_);
+  state.put(key("block.sum_activity"), sum_activity_);
+  state.put(key("block.sum_log_friction"), sum_log_friction_);
+  state.put(key("block.sum_log_supply"), sum_log_supply_);
+  state.put(key("previous_load"), previous_load_);
+  state.put(key("previous_rough_load"), previous_rough_load_);
+  state.put(key("last_expected"), last_expected_);
+  state.put(key("temperature_seen"), temperature_seen_ ? 1.0 : 0.0);
+  supply_.save(state, key("supply"));
+  chamber_supply_.save(state, key("chamber_supply"));
+  state.put(key("learned_supply"), learned_supply_);
+  cusum_.save(state, key("cusum"));
+  drift_.save(state, key("drift"));
+}
+
+void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
+  const auto key = [&](std::string_view name) { return state_key(prefix, name); };
+  reset();
+  clock_.restore(state, key("learning"));
+  const std::size_t learned = record_count(state, key("learned"), kBlockFields);
+  if (learned > learned_.capacity()) {
+    throw StateError("more learned blocks than this configuration learns");
+  }
+  learned_.resize(learned);  // within the reserved capacity
+  get_records(state, key("learned"), kBlockFields, std::span<Block>(learned_));
+  for (int i = 0; i < kRegressors; ++i) {
+    coefficients_[i] = state.get(
+        key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])));
+  }
+  block_sigma_ = state.get(key("block_sigma"));
+  block_hop_ = state.get_count(key("block.hops"));
+  block_valid_ = state.get_count(key("block.valid"));
+  if (block_hop_ >= block_hops_ || block_valid_ > block_hop_) {
+    throw StateError("block position out of range");
+  }
+  sum_feature_ = state.get(key("block.sum_feature"));
+  sum_load_ = state.get(key("block.sum_load"));
+  sum_load_squared_ = state.get(key("block.sum_load_squared"));
+  sum_activity_ = state.get(key("block.sum_activity"));
+  sum_log_friction_ = state.get(key("block.sum_log_friction"));
+  sum_log_supply_ = state.get(key("block.sum_log_supply"));
+  previous_load_ = state.get(key("previous_load"));
+  previous_rough_load_ = state.get(key("previous_rough_load"));
+  last_expected_ = state.get(key("last_expected"));
+  temperature_seen_ = state.get(key("temperature_seen")) != 0.0;
+  supply_.restore(state, key("supply"));
+  chamber_supply_.restore(state, key("chamber_supply"));
+  learned_supply_ = state.get(key("learned_supply"));
+  cusum_.restore(state, key("cusum"));
+  drift_.restore(state, key("drift"));
+}
+
+}  // namespace leakmon::detect

@@ -1,0 +1,148 @@
+// The sequential test of one pressure feature (a per-hop number that a leak lowers: the log of
+// the wavelet index, the detail correlation) against its healthy model. A healthy feature
+// still moves with the operating point, so the test learns, per rig, a quadratic model of it
+// in the load pressure plus the log of the load's activity, and tests the residual: blocks of
+// `block_seconds` (nearly independent), a CUSUM for a shift of FeaturePhysics::design_shift
+// against the null null_shift, its threshold from the target false-alarm rate.
+//
+// A real rig drifts (MODEL.md "Drifting operating conditions") and so does the healthy feature:
+// - With a `temp` observation (when the physics uses it) the log of the viscous friction
+//   factor is a regressor; its coefficient is learned, pulled towards a prior as far as the
+//   learning period saw too little temperature range to identify it.
+// - The supply is read from a `ps` observation or, with both chambers, from p1 + p2 = ps + pt at
+//   rest (SupplyTracker, rule drift_from_anchor); the load is normalised by it and the feature
+//   shifted by supply_exponent ln(ps). After a step of the supply the test does not judge for
+//   a while and re-anchors its drift reference on the blocks after the step.
+// - With one chamber and no `ps` the supply is read from that chamber's hold levels
+//   (ChamberSupplyTracker). A hold that fits neither of its clusters is a supply step: the
+//   blocks judged since the step began are taken back out of the CUSUM, and the test does not
+//   judge until the holds after the step give the new supply, then re-anchors as above.
+// - What is left of slow drift is followed (DriftReference): blocks are judged against a trend
+//   of the residuals in a window that ends `drift_guard_seconds` ago.
+// The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
+// that is all they add.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "detect/chamber_supply_tracker.hpp"
+#include "detect/cusum.hpp"
+#include "detect/detector.hpp"
+#include "detect/drift_reference.hpp"
+#include "detect/learning_schedule.hpp"
+#include "detect/supply_tracker.hpp"
+#include "sim/oil.hpp"
+#include "sim/parameters.hpp"
+
+namespace leakmon::detect {
+
+// The rig and the timing: what every detector on this test is configured with.
+struct FeatureTestOptions {
+  LearningSchedule learning;
+  bool use_p1 = true, use_p2 = true;  // the chambers acquired (the load and supply come from them)
+  sim::Parameters rig;  // ps: the configured supply (used until one is measured); pt: tank
+  double false_alarms_per_hour = 0.05;  // sets the threshold
+  double block_seconds = 0.8;           // one window (400 samples at 500 Hz)
+  // Drift following (see the file comment); 0 window switches it off.
+  double drift_guard_seconds = 60.0;
+  double drift_window_seconds = 240.0;
+  // After a supply step: no judging for this long while the reference re-anchors.
+  double supply_settle_seconds = 20.0;
+};
+
+// What the feature is: how a leak, the supply and the oil move it.
+struct FeaturePhysics {
+  // The shift of a block's mean feature the CUSUM is tuned for, and the shift that is never an
+  // alarm (the null), in the feature's units; a leak lowers the feature, so both are negative.
+  // |design_shift| also bounds the drift reference's extrapolation.
+  double design_shift = -0.08;
+  double null_shift = -0.02;
+  // d feature / d ln(ps): known physics, not learned (learning rarely sees two supplies).
+  double supply_exponent = 0.0;
+  // Whether a `temp` observation is used. Its regressor is -ln(friction factor 0.5 + 0.5 / r)
+  // with r = nu(40) / nu(T) of `oil`; `temperature_prior` is the coefficient assumed as far as
+  // learning saw too little temperature range, `temperature_prior_sigma` its uncertainty.
+  bool uses_temperature = false;
+  double temperature_prior = 0.0;
+  double temperature_prior_sigma = 0.05;
+  sim::Oil oil = sim::Oil::standard();
+};
+
+class FeatureTest {
+ public:
+  FeatureTest(const FeatureTestOptions& options, const FeaturePhysics& physics, double hop_seconds);
+
+  struct Verdict {
+    bool learning = true;
+    double learning_hops_left = kMissing;  // while learning
+    double score = kMissing;               // CUSUM / threshold; NaN when it cannot judge
+    // The healthy feature (drift reference included) the latest judged block was held against.
+    double expected = kMissing;
+  };
+  // One hop: `feature` over the window that ended at o.t (NaN: a gap; nothing is judged then),
+  // with the observation's pressures (and its temperature when the physics uses it).
+  Verdict update(const Observation& o, double feature);
+
+  static constexpr double raise_threshold() { return 1.0; }
+  static constexpr double clear_threshold() { return 0.5; }
+  double learning_seconds() const {
+    return options_.learning.settle_seconds + options_.learning.learn_seconds;
+  }
+  void reset();
+  // The drift reference, the supply transient and the CUSUM's take-back history are on the
+  // old source clock; the hop before the gap is not a neighbour of the next one.
+  void resume_after_gap();
+
+  void save(DetectorState& state, std::string_view prefix) const;
+  void restore(const DetectorState& state, std::string_view prefix);
+
+ private:
+  // One block's means: the response and its regressors.
+  struct Block {
+    double t, feature, load, load_squared, log_activity, log_friction, log_supply;
+  };
+  static constexpr std::array<RecordField<Block>, 7> kBlockFields = {
+      record_field<&Block::t>("t"),
+      record_field<&Block::feature>("feature"),
+      record_field<&Block::load>("load"),
+      record_field<&Block::load_squared>("load_squared"),
+      record_field<&Block::log_activity>("log_activity"),
+      record_field<&Block::log_friction>("log_friction"),
+      record_field<&Block::log_supply>("log_supply")};
+  static constexpr int kRegressors = 5;
+  double load_of(const Observation& o, double supply) const;
+  double expected_feature(const Block& block) const;
+  bool add_to_block(const Observation& o, double temp, double feature, double load, double supply,
+                    Block& completed);
+  double supply_for(const Observation& o, double load);
+  double supply_from_chamber(const Observation& o, double load);
+  void finish_learning();
+  double anchored_until() const;
+
+  FeatureTestOptions options_;
+  FeaturePhysics physics_;
+  std::size_t block_hops_;
+  LearningClock clock_;
+  std::vector<Block> learned_;  // reserved at construction
+  double coefficients_[kRegressors] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  double block_sigma_ = kMissing;  // long-run std. dev. of a block's residual
+  // The block being filled.
+  std::size_t block_hop_ = 0, block_valid_ = 0;
+  double sum_feature_ = 0.0, sum_load_ = 0.0, sum_load_squared_ = 0.0, sum_activity_ = 0.0;
+  double sum_log_friction_ = 0.0, sum_log_supply_ = 0.0;
+  double previous_load_ = kMissing;
+  double previous_rough_load_ = kMissing;  // normalised by the configured supply
+  double last_expected_ = kMissing;
+  bool temperature_seen_ = false;
+  bool one_chamber_;  // p1 or p2 alone: without `ps` the supply comes from its hold levels
+  SupplyTracker supply_;
+  ChamberSupplyTracker chamber_supply_;
+  double learned_supply_ = kMissing;  // the supply the learning period's blocks were formed with
+  BlockCusum cusum_;
+  DriftReference drift_;
+};
+
+}  // namespace leakmon::detect

@@ -1,0 +1,266 @@
+#include "detect/legacy_state.hpp"
+
+#include <cmath>
+#include <initializer_list>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace leakmon::detect {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Reads an old state's entries, checked as the old build checked them, into a new one.
+class Conversion {
+ public:
+  Conversion(const DetectorState& old, int version) : old_(old), out_(old.kind(), version) {}
+
+  const std::vector<double>& list(std::string_view key, std::size_t size) const {
+    const auto& values = old_.get_list(key);
+    if (values.size() != size) throw StateError("'" + std::string(key) + "' has the wrong length");
+    return values;
+  }
+  const std::vector<double>& list(std::string_view key) const { return old_.get_list(key); }
+  double get(std::string_view key) const { return old_.get(key); }
+  std::size_t count(std::string_view key) const { return old_.get_count(key); }
+
+  DetectorState& out() { return out_; }
+  void put(std::string_view key, double value) { out_.put(key, value); }
+  void put(std::string_view key, std::span<const double> values) { out_.put(key, values); }
+  // The same entry under a new name.
+  void rename(std::string_view from, std::string_view to) { out_.put(to, old_.get_list(from)); }
+  // A list's values under one name each.
+  void split(std::string_view from, std::string_view prefix,
+             std::initializer_list<std::string_view> names) {
+    const auto& values = list(from, names.size());
+    std::size_t i = 0;
+    for (const auto name : names) out_.put(state_key(prefix, name), values[i++]);
+  }
+  // Records of `names.size()` values each, flat in `values`, as one list per field.
+  void columns(std::span<const double> values, std::string_view prefix,
+               std::initializer_list<std::string_view> names) {
+    const std::size_t width = names.size();
+    if (values.size() % width != 0) {
+      throw StateError("'" + std::string(prefix) + "' is not a whole number of records");
+    }
+    std::vector<double> column(values.size() / width);
+    std::size_t field = 0;
+    for (const auto name : names) {
+      for (std::size_t i = 0; i < column.size(); ++i) column[i] = values[i * width + field];
+      out_.put(state_key(prefix, name), column);
+      ++field;
+    }
+  }
+  // A ring saved as all its slots with `next` and `count` (the old layout): its filled slots,
+  // which until it is full are the first `count`, as Ring's save_ring() lays them out.
+  void ring(std::span<const double> slots, std::size_t next, std::size_t count,
+            std::string_view prefix, std::initializer_list<std::string_view> names) {
+    const std::size_t width = names.size();
+    if (slots.size() % width != 0) {
+      throw StateError("'" + std::string(prefix) + "' is not a whole number of records");
+    }
+    const std::size_t capacity = slots.size() / width;
+    if (next >= std::max<std::size_t>(capacity, 1) || count > capacity) {
+      throw StateError("'" + std::string(prefix) + "' position out of range");
+    }
+    columns(slots.first(count * width), prefix, names);
+    out_.put_count(state_key(prefix, "next"), next);
+    out_.put_count(state_key(prefix, "capacity"), capacity);
+  }
+
+ private:
+  const DetectorState& old_;
+  DetectorState out_;
+};
+
+// flow_balance 2 -> 3.
+DetectorState flow_from_2(const DetectorState& old) {
+  Conversion c(old, 3);
+  c.put("learning.hops_seen", static_cast<double>(c.count("hops_seen")));
+  c.rename("learned_model", "learning.learned");
+  c.put("observations", static_cast<double>(c.count("observations")));
+  c.rename("previous_x", "previous_x");
+  for (const char* hop : {"before", "pending"}) {
+    c.split(hop, hop,
+            {"t", "opening", "load", "root", "leak_term", "speed", "supply", "viscosity_ratio",
+             "usable"});
+  }
+  c.columns(c.list("learned_rest_hops"), "learned",
+            {"t", "opening", "load", "root", "leak_term", "speed", "supply", "viscosity_ratio",
+             "usable", "block"});
+  c.split("positive_loads", "positive_loads", {"low", "high", "middle"});
+  c.split("negative_loads", "negative_loads", {"low", "high", "middle"});
+  c.split("coefficients", "coefficient",
+          {"constant", "side", "leak_term", "side_leak_term", "curvature_positive",
+           "curvature_negative"});
+  c.rename("hop_sigma", "hop_sigma");
+  c.rename("block_sigma", "block_sigma");
+  c.put("block.hops", static_cast<double>(c.count("block_hop")));
+  c.put("block.rest_hops", static_cast<double>(c.count("block_rest_hops")));
+  c.split("block_sums", "block", {"residual_sum", "leak_term_sum"});
+  c.split("weighted", "sizing.weighted", {"rl", "ll", "ll_sq"});
+  c.split("since_change", "sizing.since_change", {"rl", "ll", "ll_sq"});
+  c.split("change_block", "sizing.change_block", {"rl", "ll", "ll_sq"});
+  c.put("cusum.value", c.get("cusum"));
+  c.split("last_decision", "last",
+          {"score", "learning", "baseline", "index", "leak_coefficient", "leak_coefficient_ci",
+           "viscosity_ratio"});
+  // The supply's estimate and the time its last step began (the transient's start).
+  const auto& supply = c.list("supply", 2);
+  c.put("supply.estimate", supply[0]);
+  c.put("supply.anchor", kNaN);
+  c.put("supply.step_time", supply[1]);
+  c.put("supply.off_readings", 0.0);
+  c.rename("temperature_seen", "temperature_seen");
+  c.ring(c.list("trend"), c.count("trend_next"), c.count("trend_count"), "drift",
+         {"t", "residual", "scale"});
+  return c.out();
+}
+
+// One chamber's supply tracker: 17 values by position, then its holds' ring.
+void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
+                                   std::string_view prefix) {
+  constexpr std::size_t kFixed = 17;
+  if (v.size() < kFixed || (v.size() - kFixed) % 2 != 0) {
+    throw StateError("chamber supply: wrong number of values");
+  }
+  auto count = [&](std::size_t i, double limit) {
+    if (!(v[i] >= 0.0 && v[i] <= limit) || v[i] != std::floor(v[i])) {
+      throw StateError("chamber supply: a count out of range");
+    }
+    return static_cast<std::size_t>(v[i]);
+  };
+  const std::size_t capacity = (v.size() - kFixed) / 2;
+  const std::size_t next = count(0, static_cast<double>(capacity) - 1.0);
+  const std::size_t filled = count(1, static_cast<double>(capacity));
+  const std::size_t still = count(2, static_cast<double>(std::size_t{1} << 40));
+  const std::size_t used = count(3, static_cast<double>(still));
+  const std::size_t pending = count(16, 2.0);
+  c.ring(std::span<const double>(v).subspan(kFixed), next, filled, state_key(prefix, "holds"),
+         {"t", "level"});
+  c.put(state_key(prefix, "hold.still_hops"), static_cast<double>(still));
+  c.put(state_key(prefix, "hold.used_hops"), static_cast<double>(used));
+  const std::initializer_list<std::pair<std::size_t, std::string_view>> named = {
+      {4, "hold.sum"},    {5, "hold.last_t"}, {6, "hold.start"},      {7, "learned_mid"},
+      {8, "near"},        {9, "far"},         {10, "learned_offset"}, {11, "mid"},
+      {12, "last_fit_t"}, {13, "step_time"},  {14, "awaiting_since"}, {15, "awaiting_from_t"}};
+  for (const auto& [i, name] : named) c.put(state_key(prefix, name), v[i]);
+  c.put(state_key(prefix, "pending"), static_cast<double>(pending));
+}
+
+// index_cusum 3 -> 4. Its `learned_log_supply` and `block_temps` were never computed: dropped
+// (block_temps still has to be a position in the block, as 3 required).
+DetectorState index_from_3(const DetectorState& old) {
+  Conversion c(old, 4);
+  c.put("learning.hops_seen", static_cast<double>(c.count("hops_seen")));
+  c.rename("learned_model", "learning.learned");
+  c.columns(c.list("learned_blocks"), "learned",
+            {"t", "feature", "load", "load_squared", "log_activity", "log_friction", "log_supply"});
+  c.split("coefficients", "coefficient",
+          {"constant", "load", "load_squared", "log_activity", "log_friction"});
+  c.get("learned_log_supply");
+  c.rename("block_sigma", "block_sigma");
+  c.put("block.hops", static_cast<double>(c.count("block_hop")));
+  c.put("block.valid", static_cast<double>(c.count("block_valid")));
+  if (c.count("block_temps") > c.count("block_hop")) {
+    throw StateError("block position out of range");
+  }
+  c.split("block_sums", "block",
+          {"sum_feature", "sum_load", "sum_load_squared", "sum_activity", "sum_log_friction",
+           "sum_log_supply"});
+  c.rename("previous_load", "previous_load");
+  c.rename("previous_rough_load", "previous_rough_load");
+  c.rename("last_expected", "last_expected");
+  c.rename("temperature_seen", "temperature_seen");
+  c.split("supply", "supply", {"estimate", "anchor", "step_time"});
+  c.put("supply.off_readings", static_cast<double>(c.count("supply_off_hops")));
+  chamber_supply_from_positions(c, c.list("chamber_supply"), "chamber_supply");
+  c.rename("learned_supply", "learned_supply");
+  c.put("cusum.value", c.get("cusum"));
+  c.ring(c.list("cusum_history"), c.count("cusum_next"), c.count("cusum_count"), "cusum.history",
+         {"t", "before"});
+  // The index's reference is a level (scale 1 per block).
+  const auto& trend = c.list("trend");
+  std::vector<double> scaled;
+  scaled.reserve(trend.size() / 2 * 3);
+  for (std::size_t i = 0; i + 1 < trend.size(); i += 2) {
+    scaled.insert(scaled.end(), {trend[i], trend[i + 1], 1.0});
+  }
+  if (trend.size() % 2 != 0) throw StateError("'trend' is not a whole number of records");
+  c.ring(scaled, c.count("trend_next"), c.count("trend_count"), "drift",
+         {"t", "residual", "scale"});
+  return c.out();
+}
+
+// paper 1 -> 2.
+DetectorState paper_from_1(const DetectorState& old) {
+  Conversion c(old, 2);
+  c.put("learning.hops_seen", static_cast<double>(c.count("hops_seen")));
+  c.put("learning.learned", std::isnan(c.get("baseline")) ? 0.0 : 1.0);
+  c.rename("learned", "learned");
+  c.rename("baseline", "baseline");
+  const auto& below = c.list("below");
+  std::size_t count = 0;
+  for (const double v : below) {
+    if (v != 0.0 && v != 1.0) throw StateError("verdict not 0 or 1");
+    count += v != 0.0 ? 1 : 0;
+  }
+  if (count != c.count("below_count")) throw StateError("verdict count differs");
+  c.ring(below, c.count("ring_next"), c.count("ring_filled"), "window", {"below"});
+  return c.out();
+}
+
+// detail_xcorr 1 -> 2: its test was an index_cusum 3 state under "test.".
+DetectorState xcorr_from_1(const DetectorState& old) {
+  Conversion c(old, 2);
+  const DetectorState test = upgraded_state(old.get_nested("test"), "index_cusum", 4);
+  for (const auto& [key, values] : test.entries()) c.put(state_key("test", key), values);
+  c.rename("history_a", "history_a");
+  c.rename("history_b", "history_b");
+  c.put("primed", static_cast<double>(c.count("primed")));
+  // The window's hops, oldest first from the slot after the newest; the filled ones last.
+  const auto& hops = c.list("hops");
+  if (hops.size() % 5 != 0 || hops.empty()) throw StateError("'hops' is not whole hops");
+  const std::size_t window = hops.size() / 5, filled = c.count("hops_filled");
+  if (filled > window) throw StateError("filter position out of range");
+  // In the ring they fill the slots from the first, oldest first.
+  c.columns(std::span<const double>(hops).subspan(5 * (window - filled)), "hops",
+            {"aa", "bb", "ab", "e1", "e3"});
+  c.out().put_count("hops.next", filled % window);
+  c.out().put_count("hops.capacity", window);
+  c.rename("last_t", "last_t");
+  return c.out();
+}
+
+}  // namespace
+
+DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
+  if (state.kind() == kind && state.version() == version) return state;
+  if (state.kind() == kind) {
+    if (kind == "flow_balance" && state.version() == 2 && version == 3) return flow_from_2(state);
+    if (kind == "index_cusum" && state.version() == 3 && version == 4) return index_from_3(state);
+    if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "detail_xcorr" && state.version() == 1 && version == 2) return xcorr_from_1(state);
+  }
+  state.expect(kind, version);  // throws: another kind, or a layout not read here
+  return state;
+}
+
+bool has_learned(const DetectorState& state) {
+  for (const auto& [key, values] : state.entries()) {
+    if (values.size() != 1) continue;
+    const auto named = [&key](std::string_view name) {
+      return key == name || (key.size() > name.size() && key.ends_with(name) &&
+                             key[key.size() - name.size() - 1] == '.');
+    };
+    // This build's layouts: the learning clock; before: a fitted model. A baseline: paper.
+    if ((named("learning.learned") || named("learned_model")) && values[0] != 0.0) return true;
+    if (named("baseline") && !std::isnan(values[0])) return true;
+  }
+  return false;
+}
+
+}  // namespace leakmon::detect

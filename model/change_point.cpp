@@ -1,0 +1,52 @@
+#include "model/change_point.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace leakmon::model {
+
+std::vector<Segment> segments_in_time_order(const SegmentPlan& plan) {
+  std::vector<Segment> all(plan.fitting.begin(), plan.fitting.end());
+  all.insert(all.end(), plan.held_out.begin(), plan.held_out.end());
+  std::sort(all.begin(), all.end(),
+            [](const Segment& a, const Segment& b) { return a.begin < b.begin; });
+  return all;
+}
+
+std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,
+                                             std::span<const Segment> segments,
+                                             std::span<const double> log_errors,
+                                             std::size_t min_side) {
+  const std::size_t n = log_errors.size();
+  if (n < 2 * min_side || segments.size() != n) return std::nullopt;
+  // Prefix sums of the values and their squares: every split's two means and variances in
+  // constant time.
+  std::vector<double> sum(n + 1, 0.0), sum2(n + 1, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    sum[i + 1] = sum[i] + log_errors[i];
+    sum2[i + 1] = sum2[i] + log_errors[i] * log_errors[i];
+  }
+  const auto moments = [&](std::size_t a, std::size_t b) {  // [a, b)
+    const auto count = static_cast<double>(b - a);
+    const double mean = (sum[b] - sum[a]) / count;
+    const double var = std::max((sum2[b] - sum2[a]) / count - mean * mean, 0.0) * count /
+                       std::max(count - 1.0, 1.0);
+    return std::pair{mean, var / count};
+  };
+  ChangePoint best;
+  bool found = false;
+  for (std::size_t j = min_side; j + min_side <= n; ++j) {
+    const auto [before, before_var] = moments(0, j);
+    const auto [after, after_var] = moments(j, n);
+    const double se = std::sqrt(before_var + after_var);
+    const double t = se > 0.0 ? (after - before) / se : 0.0;
+    if (!found || t > best.statistic) {
+      best = {j, record.t[segments[j].begin], t, after - before};
+      found = true;
+    }
+  }
+  if (!found) return std::nullopt;
+  return best;
+}
+
+}  // namespace leakmon::model

@@ -1,0 +1,36 @@
+// Where an effect starts inside a capture (issue 24, FORMATS.md `onset_s`): a leak opening, a
+// friction changing or a transducer shifting at t0 makes the calibrated nominal model's error
+// step up at t0 and stay up, where a constant effect's error follows the operating point over
+// the whole capture and a drifting condition (the oil warming) grows it gradually. The
+// proposal is the split of the capture's segments, in time order, that separates the per-
+// segment log errors best (Welch t of later minus earlier); the model check then fits the
+// effects with that onset and lets held-out data decide between them and the constant ones.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "model/segment_predictor.hpp"
+
+namespace leakmon::model {
+
+struct ChangePoint {
+  std::size_t index = 0;   // first segment after the change (in the time-ordered list)
+  double t_s = 0.0;        // capture time of that segment's start [s]
+  double statistic = 0.0;  // Welch t of the later segments' mean log error over the earlier's
+  double step = 0.0;       // the two means' difference (natural log of the error ratio)
+};
+
+// Every segment of a plan (fitting and held-out), in time order.
+std::vector<Segment> segments_in_time_order(const SegmentPlan& plan);
+
+// `log_errors[i]`: the log mean squared error of `segments[i]` (time order). Splits leave at
+// least `min_side` segments on either side. nullopt when there are too few segments.
+std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,
+                                             std::span<const Segment> segments,
+                                             std::span<const double> log_errors,
+                                             std::size_t min_side = 8);
+
+}  // namespace leakmon::model

@@ -1,0 +1,140 @@
+// Issue 24 end to end: the model check on other rigs told their description, on descriptions
+// with one value stated wrong, and on effects that start inside the capture; the JSON of
+// FORMATS.md for each. Every run draws fresh rigs and cases (seeds printed; LEAKMON_TEST_SEED
+// reproduces a run). Quorums come from the per-draw rates `leakmon model evaluate --rigs
+// other` measured (docs/model-check.md, "Other rigs"), not from hope.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "model/diagnosis.hpp"
+#include "model/result_json.hpp"
+#include "model/synthetic_case.hpp"
+#include "tests/model/test_seed.hpp"
+#include "tests/support/paths.hpp"
+
+namespace leakmon::model {
+namespace {
+
+CaseSettings other_rig(double seconds, const std::string& misstate = "") {
+  CaseSettings s;
+  s.duration_s = seconds;
+  s.other_rig = true;
+  s.misstate = misstate;
+  return s;
+}
+
+std::string causes(const Diagnosis& d) {
+  std::string out;
+  for (const auto& c : d.causes) out += (out.empty() ? "" : "+") + c.effect;
+  return out.empty() ? d.cause : out;
+}
+
+Diagnosis diagnose_case(const SyntheticCase& c) {
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  Diagnosis d = diagnose(record, c.told);
+  std::printf("  %s\n  told: %s\n  -> %s (NRMSE %.4f -> %.4f, floor %.4f)\n",
+              c.scenario.name.c_str(), sim::describe(c.told).c_str(), causes(d).c_str(),
+              d.nrmse_before, d.nrmse_after, d.nrmse_floor);
+  return d;
+}
+
+// `python_check` asserts on the JSON `r` (Python's json module reads it, as other tools do).
+void check_json(const Diagnosis& d, const std::string& name, const std::string& python_check) {
+  const std::string dir = test::scratch_dir(name);
+  std::ofstream(dir + "/result.json") << diagnosis_json(d);
+  const std::string command = test::python() +
+                              " -c \"import json,sys; r=json.load(open(sys.argv[1])); " +
+                              python_check + "\" " + dir + "/result.json";
+  EXPECT_EQ(std::system(command.c_str()), 0) << diagnosis_json(d);
+}
+
+// A healthy rig drawn from MODEL.md's "Other rigs", told its description: `none`. Two rigs per
+// run; the evaluation's rate of `none` on told healthy rigs (docs/model-check.md) makes a run
+// with neither `none` about one in 1000, and a rig_parameter on a told rig was never seen.
+TEST(OtherRig, HealthyRigToldItsDescriptionIsNone) {
+  const auto seed = test::model_test_seed("OtherRig.HealthyRigToldItsDescriptionIsNone");
+  int nones = 0;
+  for (std::uint64_t i = 0; i < 2; ++i) {
+    const Diagnosis d = diagnose_case(draw_case(seed + i, "none", other_rig(90.0)));
+    nones += d.cause == "none";
+    EXPECT_TRUE(d.rig_check.findings.empty()) << "seed " << seed + i;
+    if (d.cause == "none") {
+      check_json(d, "model_rig_healthy",
+                 "assert r['cause']=='none'; assert r['causes']==[]; "
+                 "assert r['rig']['changed']==[]; assert 'supply_pressure' in r['rig']['stated']");
+    }
+  }
+  EXPECT_GE(nones, 1);
+}
+
+// A supply stated 15-30 % off: `rig_parameter` supply_pressure with the stated and the fitted
+// value (within 10 % of the truth), named first, and no transducer offset (the shifted levels
+// it would otherwise be taken for).
+TEST(OtherRig, MisstatedSupplyIsARigParameterNotASensorOffset) {
+  const auto seed = test::model_test_seed("OtherRig.MisstatedSupplyIsARigParameterNotASensorOffset");
+  const SyntheticCase c = draw_case(seed, "none", other_rig(90.0, "supply_pressure"));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.cause, "rig_parameter");
+  ASSERT_FALSE(d.causes.empty());
+  const auto& params = d.causes.front().params;
+  ASSERT_EQ(params.size(), 3u);
+  EXPECT_EQ(params[0].text, "supply_pressure");
+  EXPECT_EQ(params[1].value, c.misstated_stated);
+  EXPECT_NEAR(params[2].value, c.misstated_true, 0.1 * c.misstated_true);
+  for (const auto& cause : d.causes) EXPECT_NE(cause.effect, "sensor_offset");
+  EXPECT_LT(d.nrmse_after, d.nrmse_before);
+  char expected[160];
+  std::snprintf(expected, sizeof expected,
+                "assert abs(c['params']['fitted']/%.9g-1)<0.1; assert c['params']['stated']==%.9g",
+                c.misstated_true, c.misstated_stated);
+  check_json(d, "model_rig_supply",
+             std::string("c=r['causes'][0]; assert r['cause']=='rig_parameter'; "
+                         "assert c['cause']=='rig_parameter'; "
+                         "assert c['params']['parameter']=='supply_pressure'; ") +
+                 expected +
+                 "; assert 'onset_s' not in c; "
+                 "assert r['rig']['changed'][0]['parameter']=='supply_pressure'; "
+                 "assert abs(r['rig']['assumed']['supply_pressure']-c['params']['fitted'])<1; "
+                 "assert set(r['calibrated'])=={'beta','Kv','m','b'}");
+}
+
+// A load stiffness stated 40-80 % off: `rig_parameter` load_stiffness, fitted within 10 %.
+TEST(OtherRig, MisstatedLoadStiffnessIsARigParameter) {
+  const auto seed = test::model_test_seed("OtherRig.MisstatedLoadStiffnessIsARigParameter");
+  const SyntheticCase c = draw_case(seed, "none", other_rig(90.0, "load_stiffness"));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.cause, "rig_parameter");
+  ASSERT_EQ(d.causes.size(), 1u) << causes(d);
+  EXPECT_EQ(d.causes.front().params[0].text, "load_stiffness");
+  EXPECT_NEAR(d.causes.front().params[2].value, c.misstated_true, 0.1 * c.misstated_true);
+}
+
+// The issue's capture: a leak opening inside a capture of the paper's rig at constant
+// temperature. Named internal_leakage with its onset within 2 s (on main it was `unexplained`,
+// "drift such as the oil warming up"); the JSON carries onset_s.
+TEST(Onset, LeakOpeningInsideTheCaptureIsNamedWithItsOnset) {
+  const auto seed = test::model_test_seed("Onset.LeakOpeningInsideTheCaptureIsNamedWithItsOnset");
+  CaseSettings settings;
+  settings.duration_s = 120.0;
+  settings.onset = true;
+  const SyntheticCase c = draw_case(seed, "internal_leakage", settings);
+  const Diagnosis d = diagnose_case(c);
+  std::printf("  true onset %.2f s, C_L %.3g\n", c.onset_s, c.main_value);
+  ASSERT_EQ(d.cause, "internal_leakage") << causes(d);
+  EXPECT_EQ(d.causes.size(), 1u) << causes(d);
+  EXPECT_NEAR(d.causes.front().onset_s, c.onset_s, 2.0);
+  EXPECT_NEAR(d.causes.front().params.front().value, c.main_value, 0.25 * c.main_value);
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "assert abs(c['onset_s']-%.6f)<2", c.onset_s);
+  check_json(d, "model_rig_onset",
+             std::string("c=r['causes'][0]; assert c['cause']=='internal_leakage'; ") + expected);
+}
+
+}  // namespace
+}  // namespace leakmon::model
