@@ -367,10 +367,10 @@ TEST(DaemonConfig, AnActuatorsRigIsReadAndSetsTheTransducersRange) {
   EXPECT_EQ(a.rig.source, "rig.yaml:5:10");
   // 21 MPa: the 25 MPa range (sim::sensors_for), 12 bit, for both chambers.
   EXPECT_DOUBLE_EQ(a.transducers[capture::Role::p1].max, 25e6);
-  EXPECT_DOUBLE_EQ(a.p2_transducer.resolution, 25e6 / 4096.0);
+  EXPECT_DOUBLE_EQ(a.transducers[capture::Role::p2].resolution, 25e6 / 4096.0);
   // A configured transducer range wins; without a rig, MODEL.md's 20.7 MPa.
   EXPECT_DOUBLE_EQ(config.actuators.at(1).transducers[capture::Role::p1].max, 40e6);
-  EXPECT_DOUBLE_EQ(config.actuators.at(1).p2_transducer.max, 25e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).transducers[capture::Role::p2].max, 25e6);
   EXPECT_TRUE(config.actuators.at(2).rig.nominal());
   EXPECT_DOUBLE_EQ(config.actuators.at(2).transducers[capture::Role::p1].max, 20.7e6);
   EXPECT_TRUE(config.warnings.empty());
