@@ -2,7 +2,7 @@
 // calibration spread (both controllers, spring 40-120 kN/m, beta, Kv, m, b, reference
 // amplitudes and seeds), healthy runs and runs with a leak switched on mid-run, simulates each
 // (sim/) and replays it in process through exactly the daemon's pipeline
-// (daemon::replay_capture). Every detector under test is one actuator of the replayed
+// (pipeline::replay_capture). Every detector under test is one actuator of the replayed
 // configuration, at several alarm thresholds, so one replay yields the whole ROC sweep. Writes
 // runs.json (every run and alarm), summary.json, summary.tsv, summary.md, conditions.md and
 // conditions.tsv into --out (programs.tsv and wear.tsv under those conditions), and the plots

@@ -45,17 +45,14 @@ ChannelUse use_of(const daemon::DaemonConfig& config, const std::string& driver,
                   const std::string& channel) {
   ChannelUse use;
   for (const auto& a : config.actuators) {
-    const std::pair<const char*, const daemon::ChannelRef*> refs[] = {
-        {"p1", &a.p1},     {"p2", &a.p2}, {"u", &a.u},      {"x", &a.x},
-        {"xref", &a.xref}, {"ps", &a.ps}, {"temp", &a.temp}};
-    for (const auto& [role, ref] : refs) {
-      if (!ref->present() || ref->driver != driver || ref->channel != channel) continue;
-      use.roles.push_back(fmt::format("{}.{}", a.name, role));
-      use.unit = unit_of_role(role);
-      const detect::TransducerSpec* spec = std::string_view(role) == "p1"   ? &a.p1_transducer
-                                           : std::string_view(role) == "p2" ? &a.p2_transducer
-                                           : std::string_view(role) == "x"  ? &a.x_transducer
-                                                                            : nullptr;
+    for (const capture::Role role : capture::kRoles) {
+      const pipeline::ChannelRef& ref = a.channels[role];
+      if (!ref.present() || ref.driver != driver || ref.channel != channel) continue;
+      use.roles.push_back(fmt::format("{}.{}", a.name, capture::to_string(role)));
+      use.unit = unit_of_role(capture::to_string(role));
+      const bool checked = std::find(pipeline::kCheckedRoles.begin(), pipeline::kCheckedRoles.end(),
+                                     role) != pipeline::kCheckedRoles.end();
+      const detect::TransducerSpec* spec = checked ? &a.transducers[role] : nullptr;
       if (spec != nullptr && spec->enabled) {
         use.min = std::max(use.min, spec->min);
         use.max = std::min(use.max, spec->max);
@@ -148,7 +145,7 @@ int run_probe(int argc, char** argv) {
     ProbedDriver p;
     p.driver = daemon::make_driver(*driver.node);
     p.type = driver.type;
-    if (const auto* group = daemon::group_of_driver(config, driver.name)) {
+    if (const auto* group = pipeline::group_of_driver(config, driver.name)) {
       p.period_ns = group->period_ns;
     }
     p.channels.resize(p.driver->channels().size());

@@ -1,6 +1,6 @@
 // `leakmon replay --in CAPTURE.csv --events EVENTS.jsonl [--config CONFIG.yaml | --rig RIG.yaml]
 // [--realtime]`
-// (FORMATS.md): a capture through the daemon's pipeline (daemon/replay.hpp).
+// (FORMATS.md): a capture through the daemon's pipeline (pipeline/replay.hpp).
 #include <fmt/format.h>
 
 #include <fstream>
@@ -10,9 +10,9 @@
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/learning_report.hpp"
-#include "daemon/replay.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/learning_report.hpp"
+#include "pipeline/replay.hpp"
 #include "sim/rig_description.hpp"
 
 namespace leakmon::cli {
@@ -46,19 +46,19 @@ int run_replay(int argc, char** argv) {
   if (!args.get("rig").empty()) rig = sim::load_rig_file(args.get("rig"));
   auto capture = std::make_shared<const capture::Capture>(capture::read_capture(args.get("in")));
   daemon::DaemonConfig config = args.get("config").empty()
-                                    ? daemon::default_replay_config(*capture)
+                                    ? pipeline::default_replay_config(*capture)
                                     : daemon::load_config(args.get("config"));
-  if (rig) daemon::apply_rig(config.actuators.front(), *rig);
+  if (rig) pipeline::apply_rig(config.actuators.front(), *rig);
   for (const auto& warning : config.warnings) fmt::print(stderr, "warning: {}\n", warning);
-  daemon::ReplayOptions options;
+  pipeline::ReplayOptions options;
   options.realtime = args.flag_set("realtime");
   options.state_directory = args.get("state-dir");
-  const auto result = daemon::replay_capture(capture, config, options);
+  const auto result = pipeline::replay_capture(capture, config, options);
 
   std::ofstream out(args.get("events"));
   if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.get("events")));
   for (const auto& event : result.events) {
-    out << daemon::to_json_line(event) << '\n';
+    out << pipeline::to_json_line(event) << '\n';
     if (event.kind == io::EventKind::state_discarded) {
       fmt::print(stderr, "warning: {}\n", event.message);
     }
@@ -72,8 +72,8 @@ int run_replay(int argc, char** argv) {
   for (const auto& status : result.actuators) {
     for (const auto& actuator : config.actuators) {
       if (actuator.name != status.name) continue;
-      fmt::print(stderr, "{}\n", daemon::detector_line(actuator, status));
-      if (const auto line = daemon::learning_line(status); !line.empty()) {
+      fmt::print(stderr, "{}\n", pipeline::detector_line(actuator, status));
+      if (const auto line = pipeline::learning_line(status); !line.empty()) {
         fmt::print(stderr, "{}\n", line);
       }
     }

@@ -1,5 +1,5 @@
 // `leakmon state show|reset|learn` and `leakmon learn`: what the daemon keeps across restarts
-// in its state directory (daemon/state_store.hpp, docs/daemon.md "Restarts").
+// in its state directory (pipeline/state_store.hpp, docs/daemon.md "Restarts").
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
@@ -13,9 +13,9 @@
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
-#include "daemon/replay.hpp"
-#include "daemon/state_store.hpp"
 #include "detect/legacy_state.hpp"
+#include "pipeline/replay.hpp"
+#include "pipeline/state_store.hpp"
 
 namespace leakmon::cli {
 namespace {
@@ -54,17 +54,18 @@ Target target_of(const ArgParser& args) {
 }
 
 int show(const Target& target) {
-  const daemon::StateStore store(target.directory);
+  const pipeline::StateStore store(target.directory);
   const auto listing = store.list();
   fmt::print("state directory {}: {} saved actuator state(s)\n", target.directory,
              listing.states.size());
-  std::vector<std::pair<std::string, daemon::StateFingerprint>> expected;
-  if (target.config) expected = daemon::state_fingerprints(*target.config);
+  std::vector<std::pair<std::string, pipeline::StateFingerprint>> expected;
+  if (target.config) expected = pipeline::state_fingerprints(*target.config);
   for (const auto& state : listing.states) {
     fmt::print("actuator {}: saved {}, detector {} ({}), alarm {}{}\n", state.actuator,
                utc(state.saved_unix), state.detector.kind(),
                detect::has_learned(state.detector) ? "learned" : "still learning",
-               daemon::to_string(state.alarm), state.alarm_condition ? " (condition active)" : "");
+               pipeline::to_string(state.alarm),
+               state.alarm_condition ? " (condition active)" : "");
     for (const auto& [name, value] : state.fingerprint.parts) {
       fmt::print("  {}: {}\n", name, value);
     }
@@ -94,7 +95,7 @@ int show(const Target& target) {
 }
 
 int reset(const Target& target, const std::string& actuator) {
-  const daemon::StateStore store(target.directory);
+  const pipeline::StateStore store(target.directory);
   std::vector<std::string> names;
   if (!actuator.empty()) {
     names.push_back(actuator);
@@ -121,7 +122,7 @@ int reset(const Target& target, const std::string& actuator) {
 int learn(const Target& target, const std::string& capture_path) {
   if (!target.config) throw UsageError("learn needs --config (the actuators to learn)");
   auto capture = std::make_shared<const capture::Capture>(capture::read_capture(capture_path));
-  const auto result = daemon::replay_capture(capture, *target.config, {});
+  const auto result = pipeline::replay_capture(capture, *target.config, {});
   for (const auto& event : result.events) {
     if (event.kind == io::EventKind::alarm_raised) {
       fmt::print(stderr,
@@ -130,11 +131,11 @@ int learn(const Target& target, const std::string& capture_path) {
                  event.actuator, event.alarm, event.t, capture_path);
     }
   }
-  const daemon::StateStore store(target.directory);
+  const pipeline::StateStore store(target.directory);
   int status = 0;
   for (auto state : result.learned) {
     // A known-good capture teaches the detector; it does not hand the daemon an alarm.
-    state.alarm = daemon::AlarmState::normal;
+    state.alarm = pipeline::AlarmState::normal;
     state.alarm_condition = false;
     store.save(state);
     const bool done = detect::has_learned(state.detector);

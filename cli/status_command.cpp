@@ -6,8 +6,8 @@
 #include "cli/args.hpp"
 #include "cli/subcommands.hpp"
 #include "daemon/config.hpp"
-#include "daemon/http_endpoint.hpp"
-#include "daemon/status_json.hpp"
+#include "http/http_endpoint.hpp"
+#include "views/status_json.hpp"
 
 namespace leakmon::cli {
 namespace {
@@ -29,8 +29,8 @@ void endpoint_options(ArgParser& args) {
 }
 
 // Address, port and the acknowledgement token (metrics.ack_token) of the daemon's endpoint.
-daemon::MetricsConfig endpoint(const ArgParser& args) {
-  daemon::MetricsConfig metrics;  // the daemon's own defaults
+pipeline::MetricsConfig endpoint(const ArgParser& args) {
+  pipeline::MetricsConfig metrics;  // the daemon's own defaults
   const std::string config = args.get("config");
   if (args.get("port").empty()) {
     // A configuration named on the command line must exist; the default one may be absent (a
@@ -57,12 +57,12 @@ int run_status(int argc, char** argv) {
   args.flag("json", "print the daemon's JSON status as it is");
   if (!args.parse(argc, argv)) return 0;
   const auto metrics = endpoint(args);
-  const auto response = daemon::http_request(metrics.address, metrics.port, "GET", "/status");
+  const auto response = http::http_request(metrics.address, metrics.port, "GET", "/status");
   if (response.status != 200 || args.flag_set("json")) {
     fmt::print("{}", response.body);
     return response.status == 200 ? 0 : 1;
   }
-  fmt::print("{}", daemon::status_text_from_json(response.body));
+  fmt::print("{}", views::status_text_from_json(response.body));
   return 0;
 }
 
@@ -74,12 +74,12 @@ int run_ack(int argc, char** argv) {
   const auto metrics = endpoint(args);
   const std::string actuator = args.get("actuator");
   std::string query;
-  if (!actuator.empty()) query = "actuator=" + daemon::percent_encode(actuator);
+  if (!actuator.empty()) query = "actuator=" + http::percent_encode(actuator);
   if (!metrics.ack_token.empty()) {
-    query += (query.empty() ? "" : "&") + ("token=" + daemon::percent_encode(metrics.ack_token));
+    query += (query.empty() ? "" : "&") + ("token=" + http::percent_encode(metrics.ack_token));
   }
-  const auto response = daemon::http_request(metrics.address, metrics.port, "POST",
-                                             query.empty() ? "/ack" : "/ack?" + query);
+  const auto response = http::http_request(metrics.address, metrics.port, "POST",
+                                           query.empty() ? "/ack" : "/ack?" + query);
   fmt::print("{}", response.body);
   return response.status == 200 ? 0 : 1;
 }

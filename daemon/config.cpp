@@ -24,15 +24,17 @@
 #include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
 #include "daemon/output_registry.hpp"
-#include "daemon/sample.hpp"
 #include "detect/factory.hpp"
+#include "detect/rig_options.hpp"
 #include "io/modbus/modbus_config.hpp"
 #include "io/modbus/modbus_link.hpp"
-#include "detect/rig_options.hpp"
+#include "realtime/sample.hpp"
 #include "sim/rig_draw.hpp"
 
 namespace leakmon::daemon {
 namespace {
+
+using capture::Role;
 
 std::string checked_name(const config::ConfigNode& node, std::set<std::string>& seen,
                          std::string_view what) {
@@ -52,10 +54,10 @@ std::string checked_name(const config::ConfigNode& node, std::set<std::string>& 
   return name;
 }
 
-ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig& config) {
+pipeline::ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig& config) {
   const std::string text = node.as_string();
   const auto dot = text.find('.');
-  ChannelRef ref;
+  pipeline::ChannelRef ref;
   ref.where = node;
   if (dot == std::string::npos) {
     if (config.drivers.size() != 1) {
@@ -71,8 +73,9 @@ ChannelRef parse_channel_ref(const config::ConfigNode& node, const DaemonConfig&
     ref.channel = text.substr(dot + 1);
   }
   if (ref.channel.empty()) node.fail(fmt::format("'{}': empty channel name", text));
-  const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
-                                 [&](const DriverConfig& d) { return d.name == ref.driver; });
+  const bool known =
+      std::any_of(config.drivers.begin(), config.drivers.end(),
+                  [&](const pipeline::DriverConfig& d) { return d.name == ref.driver; });
   if (!known) node.fail(fmt::format("'{}': no driver named '{}'", text, ref.driver));
   return ref;
 }
@@ -136,9 +139,9 @@ void convert_leak_sizes(const config::ConfigNode& options) {
   }
 }
 
-AlarmSettings parse_alarm(const config::ConfigNode& node) {
+pipeline::AlarmSettings parse_alarm(const config::ConfigNode& node) {
   node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching"});
-  AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
+  pipeline::AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   if (node.has("raise")) alarm.raise_threshold = node.get_double("raise", -1e9, 1e9);
   if (node.has("clear")) alarm.clear_threshold = node.get_double("clear", -1e9, 1e9);
   if (!std::isnan(alarm.raise_threshold) && !std::isnan(alarm.clear_threshold) &&
@@ -186,20 +189,9 @@ detect::TransducerSpec parse_transducer(const config::ConfigNode& node,
   return spec;
 }
 
-// The pressure transducers a rig that states its supply is fitted with: 12 bit over the usual
-// range above its supply (sim::sensors_for: MODEL.md's 0-20.7 MPa for the paper's 17.2 MPa), as
-// the simulator assumes for it.
-detect::TransducerSpec pressure_transducer_for(const sim::RigDescription& rig) {
-  detect::TransducerSpec spec = detect::TransducerSpec::pressure();
-  if (!rig.states("supply_pressure")) return spec;
-  spec.max = sim::sensors_for(rig.params).pressure_full_scale;
-  spec.resolution = spec.max / 4096.0;
-  return spec;
-}
-
 // A detector option that restates a value of the actuator's `rig:` overrides it: valid, but the
 // two places may disagree, so say where both are.
-void warn_restated(const ActuatorConfig& actuator, const config::ConfigNode& rig_node,
+void warn_restated(const pipeline::ActuatorConfig& actuator, const config::ConfigNode& rig_node,
                    std::vector<std::string>& warnings) {
   if (!actuator.detector_options) return;
   for (const auto& restated :
@@ -216,28 +208,33 @@ void warn_restated(const ActuatorConfig& actuator, const config::ConfigNode& rig
   }
 }
 
-ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
-                              std::set<std::string>& names, std::vector<std::string>& warnings) {
+pipeline::ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig& config,
+                                        std::set<std::string>& names,
+                                        std::vector<std::string>& warnings) {
   node.expect_keys({"name", "channels", "features", "detector", "alarm", "transducers", "rig"});
-  ActuatorConfig actuator;
+  pipeline::ActuatorConfig actuator;
   actuator.name = checked_name(node, names, "actuator");
   const auto channels = node.at("channels");
-  channels.expect_keys({"p1", "p2", "u", "x", "xref", "ps", "temp"});
-  actuator.p1 = parse_channel_ref(channels.at("p1"), config);
-  for (auto [role, ref] : {std::pair{"p2", &actuator.p2}, std::pair{"u", &actuator.u},
-                           std::pair{"x", &actuator.x}, std::pair{"xref", &actuator.xref},
-                           std::pair{"ps", &actuator.ps}, std::pair{"temp", &actuator.temp}}) {
-    if (auto n = channels.find(role)) *ref = parse_channel_ref(*n, config);
+  std::vector<std::string> role_names;
+  for (const Role role : capture::kRoles) role_names.emplace_back(capture::to_string(role));
+  channels.expect_keys(role_names);
+  const pipeline::ChannelRef& p1 = actuator.channels[Role::p1];
+  actuator.channels[Role::p1] = parse_channel_ref(channels.at("p1"), config);
+  for (const Role role : capture::kRoles) {
+    if (role == Role::p1) continue;
+    if (auto n = channels.find(capture::to_string(role))) {
+      actuator.channels[role] = parse_channel_ref(*n, config);
+    }
   }
   // One actuator's signals must be sampled together (one group, one clock).
-  const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
-  for (const auto* ref :
-       {&actuator.p2, &actuator.u, &actuator.x, &actuator.xref, &actuator.ps, &actuator.temp}) {
-    if (ref->present() && group_of_driver(config, ref->driver) != group) {
+  const pipeline::GroupConfig* group = pipeline::group_of_driver(config, p1.driver);
+  for (const Role role : capture::kRoles) {
+    const pipeline::ChannelRef& ref = actuator.channels[role];
+    if (ref.present() && pipeline::group_of_driver(config, ref.driver) != group) {
       channels.fail(
           fmt::format("channel '{}' is sampled in another group than p1 '{}': one "
                       "actuator's channels must come from one sampling group",
-                      ref->text(), actuator.p1.text()));
+                      ref.text(), p1.text()));
     }
   }
   if (auto features = node.find("features")) actuator.features = parse_features(*features);
@@ -258,7 +255,7 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
   }
   const auto rig = node.find("rig");
   if (rig) {
-    apply_rig(actuator, sim::read_rig(*rig));
+    pipeline::apply_rig(actuator, sim::read_rig(*rig));
     warn_restated(actuator, *rig, warnings);
   }
   if (auto alarm = node.find("alarm")) {
@@ -266,20 +263,22 @@ ActuatorConfig parse_actuator(const config::ConfigNode& node, const DaemonConfig
     actuator.alarm_name = alarm->get_string("name", actuator.alarm_name);
   }
   if (auto transducers = node.find("transducers")) {
-    transducers->expect_keys({"p1", "p2", "x"});
-    for (auto [role, spec] :
-         {std::pair{"p1", &actuator.p1_transducer}, std::pair{"p2", &actuator.p2_transducer},
-          std::pair{"x", &actuator.x_transducer}}) {
-      if (auto n = transducers->find(role)) *spec = parse_transducer(*n, *spec);
+    std::vector<std::string> checked;
+    for (const Role role : pipeline::kCheckedRoles) checked.emplace_back(capture::to_string(role));
+    transducers->expect_keys(checked);
+    for (const Role role : pipeline::kCheckedRoles) {
+      if (auto n = transducers->find(capture::to_string(role))) {
+        actuator.transducers[role] = parse_transducer(*n, actuator.transducers[role]);
+      }
     }
   }
   return actuator;
 }
 
-GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& config,
-                        std::set<std::string>& names, std::set<std::string>& grouped) {
+pipeline::GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& config,
+                                  std::set<std::string>& names, std::set<std::string>& grouped) {
   node.expect_keys({"name", "period_ms", "drivers", "priority", "cpus", "ring_capacity"});
-  GroupConfig group;
+  pipeline::GroupConfig group;
   group.name = checked_name(node, names, "sampling group");
   group.period_ns = static_cast<std::int64_t>(
       std::llround(node.get_double("period_ms", 2.0, 0.05, 10000.0) * 1e6));
@@ -295,7 +294,7 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
   for (const auto& item : node.at("drivers").items()) {
     const std::string name = item.as_string();
     const bool known = std::any_of(config.drivers.begin(), config.drivers.end(),
-                                   [&](const DriverConfig& d) { return d.name == name; });
+                                   [&](const pipeline::DriverConfig& d) { return d.name == name; });
     if (!known) item.fail(fmt::format("no driver named '{}'", name));
     if (!grouped.insert(name).second) {
       item.fail(fmt::format("driver '{}' is already in another sampling group", name));
@@ -308,20 +307,6 @@ GroupConfig parse_group(const config::ConfigNode& node, const DaemonConfig& conf
 
 }  // namespace
 
-void apply_rig(ActuatorConfig& actuator, sim::RigDescription rig) {
-  actuator.rig = std::move(rig);
-  actuator.p1_transducer = actuator.p2_transducer = pressure_transducer_for(actuator.rig);
-}
-
-const GroupConfig* group_of_driver(const DaemonConfig& config, const std::string& driver) {
-  for (const auto& group : config.groups) {
-    if (std::find(group.drivers.begin(), group.drivers.end(), driver) != group.drivers.end()) {
-      return &group;
-    }
-  }
-  return nullptr;
-}
-
 using config::resolve_path;
 
 DaemonConfig parse_config(const config::ConfigNode& root) {
@@ -333,7 +318,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
   std::set<std::string> driver_names;
   const auto drivers = root.at("drivers");
   for (const auto& node : drivers.items()) {
-    DriverConfig driver;
+    pipeline::DriverConfig driver;
     driver.name = checked_name(node, driver_names, "driver");
     driver.type = node.get_string("type");
     driver.node = node;
@@ -352,7 +337,7 @@ DaemonConfig parse_config(const config::ConfigNode& root) {
       }
     }
   } else {
-    GroupConfig group;
+    pipeline::GroupConfig group;
     for (const auto& driver : config.drivers) group.drivers.push_back(driver.name);
     config.groups.push_back(group);
   }
@@ -459,29 +444,27 @@ void check_channels(const DaemonConfig& config,
   for (const auto& group : config.groups) {
     std::size_t count = 0;
     for (const auto& driver : group.drivers) count += channels_of(driver).size();
-    if (count > kMaxGroupChannels) {
+    if (count > realtime::kMaxGroupChannels) {
       throw config::ConfigError(fmt::format("{}: sampling group '{}' has {} channels; at most {}",
-                                            config.source, group.name, count, kMaxGroupChannels));
+                                            config.source, group.name, count,
+                                            realtime::kMaxGroupChannels));
     }
   }
   for (const auto& actuator : config.actuators) {
-    for (const auto* ref : {&actuator.p1, &actuator.p2, &actuator.u, &actuator.x, &actuator.xref,
-                            &actuator.ps, &actuator.temp}) {
-      if (!ref->present()) continue;
-      const auto& names = channels_of(ref->driver);
-      if (std::find(names.begin(), names.end(), ref->channel) != names.end()) continue;
+    for (const Role role : capture::kRoles) {
+      const pipeline::ChannelRef& ref = actuator.channels[role];
+      if (!ref.present()) continue;
+      const auto& names = channels_of(ref.driver);
+      if (std::find(names.begin(), names.end(), ref.channel) != names.end()) continue;
       const std::string message = fmt::format("driver '{}' has no channel '{}' (it has: {})",
-                                              ref->driver, ref->channel, fmt::join(names, ", "));
-      if (ref->where) ref->where->fail(message);
+                                              ref.driver, ref.channel, fmt::join(names, ", "));
+      if (ref.where) ref.where->fail(message);
       throw config::ConfigError(fmt::format("{}: {}", config.source, message));
     }
     // Build the detector once so that its options and signal needs are checked now.
-    const GroupConfig* group = group_of_driver(config, actuator.p1.driver);
-    detect::AvailableSignals signals;
-    signals.p1 = true;
-    signals.p2 = actuator.p2.present();
-    signals.u = actuator.u.present();
-    signals.x = actuator.x.present();
+    const pipeline::GroupConfig* group =
+        pipeline::group_of_driver(config, actuator.channels[Role::p1].driver);
+    const detect::AvailableSignals signals = pipeline::available_signals(actuator.acquired());
     const double hop_seconds = static_cast<double>(actuator.features.step) *
                                static_cast<double>(group ? group->period_ns : 2'000'000) / 1e9;
     try {

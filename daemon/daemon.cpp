@@ -8,15 +8,19 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <limits>
 
-#include "capture/units.hpp"
 #include "daemon/driver_registry.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/http_router.hpp"
-#include "daemon/learning_report.hpp"
 #include "daemon/output_registry.hpp"
+#include "daemon/routes.hpp"
+#include "http/http_router.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/learning_report.hpp"
+#include "views/metrics_text.hpp"
+#include "views/status_json.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -69,8 +73,9 @@ Daemon::~Daemon() { stop(); }
 
 std::vector<std::unique_ptr<io::EventSink>> Daemon::build_sinks(const DaemonConfig& config) const {
   std::vector<std::unique_ptr<io::EventSink>> sinks;
-  sinks.push_back(std::make_unique<LogEventSink>());
-  if (!config.event_log.empty()) sinks.push_back(std::make_unique<JsonlEventLog>(config.event_log));
+  sinks.push_back(std::make_unique<pipeline::LogEventSink>());
+  if (!config.event_log.empty())
+    sinks.push_back(std::make_unique<pipeline::JsonlEventLog>(config.event_log));
   for (const auto& node : config.outputs) sinks.push_back(make_output(node));
   if (operator_view_) sinks.push_back(operator_view_->event_sink());  // the page's last events
   return sinks;
@@ -86,14 +91,12 @@ void Daemon::attach_readings(const std::vector<std::unique_ptr<io::EventSink>>& 
                              bool attach) const {
   io::ReadingSource source;
   if (attach) {
-    const Worker* worker = worker_.get();
-    source = [worker] {
+    source = [this] {
+      views::ServiceSnapshot snapshot;
+      fill_actuators(snapshot);  // all a feature message reads
       std::vector<io::ActuatorReading> readings;
-      for (const auto& a : worker->status()) {
-        readings.push_back({a.name, a.t, a.index_p1, a.score,
-                            units::lpm_per_mpa(a.leak_coefficient),
-                            units::lpm_per_mpa(a.leak_coefficient_ci),
-                            std::string(to_string(a.state)), a.learning});
+      for (const auto& a : snapshot.actuators) {
+        readings.push_back({a.name, views::features_json(snapshot, a)});
       }
       return readings;
     };
@@ -115,11 +118,11 @@ void Daemon::start() {
   pthread_attr_setstacksize(&attr, kThreadStackBytes);
   pthread_setattr_default_np(&attr);
   pthread_attr_destroy(&attr);
-  if (const std::string warning = lock_process_memory(); !warning.empty()) {
+  if (const std::string warning = realtime::lock_process_memory(); !warning.empty()) {
     spdlog::warn("{}", warning);
   }
   if (config_.cpu_wakeup_latency_us >= 0) {
-    cpu_latency_ = CpuLatencyRequest(config_.cpu_wakeup_latency_us);
+    cpu_latency_ = realtime::CpuLatencyRequest(config_.cpu_wakeup_latency_us);
     if (!cpu_latency_.held()) spdlog::warn("{}", cpu_latency_.warning());
   }
 
@@ -128,45 +131,46 @@ void Daemon::start() {
     drivers_.back()->start();
     driver_watch_.emplace_back();
   }
-  std::vector<GroupInput> inputs;
+  std::vector<pipeline::GroupInput> inputs;
   for (const auto& group_config : config_.groups) {
     auto group = std::make_unique<Group>();
     group->config = group_config;
-    std::vector<ChannelRef> channels;
+    std::vector<pipeline::ChannelRef> channels;
     for (const auto& name : group_config.drivers) {
       for (std::size_t i = 0; i < config_.drivers.size(); ++i) {
         if (config_.drivers[i].name != name) continue;
         group->drivers.push_back(drivers_[i].get());
         for (const auto& channel : drivers_[i]->channels()) {
-          channels.push_back(ChannelRef{name, channel, std::nullopt});
+          channels.push_back(pipeline::ChannelRef{name, channel, std::nullopt});
         }
       }
     }
-    group->ring = std::make_unique<SpscRing<Sample>>(group_config.ring_capacity);
-    group->loop =
-        std::make_unique<AcquisitionLoop>(group_config.period_ns, group->drivers, *group->ring);
-    inputs.push_back(
-        GroupInput{group_config.name, group->ring.get(), channels, group_config.period_ns});
+    group->ring =
+        std::make_unique<realtime::SpscRing<realtime::Sample>>(group_config.ring_capacity);
+    group->loop = std::make_unique<realtime::AcquisitionLoop>(group_config.period_ns,
+                                                              group->drivers, *group->ring);
+    inputs.push_back(pipeline::GroupInput{group_config.name, group->ring.get(), channels,
+                                          group_config.period_ns});
     groups_.push_back(std::move(group));
   }
   reported_overruns_.assign(groups_.size(), 0);
   if (config_.metrics.port != 0) {
     std::vector<std::string> group_names;
     for (const auto& group : groups_) group_names.push_back(group->config.name);
-    operator_view_ = std::make_unique<OperatorView>(config_, group_names);
+    operator_view_ = std::make_unique<views::OperatorView>(config_, group_names);
     // The page shows what happened before a restart, starting with the log's newest events.
     if (!config_.event_log.empty()) operator_view_->restore_events(config_.event_log);
   }
   sinks_ = build_sinks(config_);
-  worker_ = std::make_unique<Worker>(config_, inputs, raw(sinks_));
+  worker_ = std::make_unique<pipeline::Worker>(config_, inputs, raw(sinks_));
   attach_readings(sinks_, true);
   // What was learned before a restart comes back before the first sample is acquired.
   if (!config_.state.directory.empty()) {
-    state_store_ = std::make_unique<StateStore>(config_.state.directory);
+    state_store_ = std::make_unique<pipeline::StateStore>(config_.state.directory);
     worker_->restore_states(*state_store_);
     // A file that fits the configuration is what the detector resumed from: its age is the
     // learned state's until the next save.
-    const auto fingerprints = state_fingerprints(config_);
+    const auto fingerprints = pipeline::state_fingerprints(config_);
     const auto listing = state_store_->list();
     const std::lock_guard lock(state_saved_mutex_);
     for (const auto& state : listing.states) {
@@ -191,7 +195,9 @@ void Daemon::start() {
   // Which detector runs for each actuator, and how long it learns before it can raise alarms.
   for (const auto& status : worker_->status()) {
     for (const auto& actuator : config_.actuators) {
-      if (actuator.name == status.name) spdlog::info("{}", detector_line(actuator, status));
+      if (actuator.name == status.name) {
+        spdlog::info("{}", pipeline::detector_line(actuator, status));
+      }
     }
     learning_[status.name] = status.learning;
   }
@@ -209,10 +215,10 @@ void Daemon::start() {
   std::atomic<bool> worker_ready{false};
   worker_thread_ = std::thread([this, &worker_warnings, &worker_ready] {
     const std::int64_t poll_ns = config_.worker_poll_ns;
-    worker_warnings = make_thread_realtime(config_.worker_priority, {}).warnings;
+    worker_warnings = realtime::make_thread_realtime(config_.worker_priority, {}).warnings;
     worker_ready.store(true, std::memory_order_release);
     while (!stop_worker_.load(std::memory_order_acquire)) {
-      if (worker_->drain(monotonic_now_ns()) == 0) {
+      if (worker_->drain(realtime::monotonic_now_ns()) == 0) {
         std::this_thread::sleep_for(std::chrono::nanoseconds(poll_ns));
       }
     }
@@ -220,7 +226,7 @@ void Daemon::start() {
   for (auto& group : groups_) {
     Group* g = group.get();
     g->thread = std::thread([this, g] {
-      g->realtime = make_thread_realtime(g->config.priority, g->config.cpus);
+      g->realtime = realtime::make_thread_realtime(g->config.priority, g->config.cpus);
       g->realtime_ready.store(true, std::memory_order_release);
       g->loop->run(stop_acquisition_);
     });
@@ -242,14 +248,15 @@ void Daemon::start() {
                  group->realtime.fifo ? fmt::format("SCHED_FIFO {}", group->config.priority)
                                       : std::string("normal scheduling"));
   }
+  set_ack_token(config_.metrics.ack_token);
   if (config_.metrics.port != 0) {
-    endpoint_ = std::make_unique<HttpEndpoint>(
+    endpoint_ = std::make_unique<http::HttpEndpoint>(
         config_.metrics.address, config_.metrics.port,
-        [this](const HttpRequest& request) { return handle(request); }, HttpLimits{},
+        [this](const http::HttpRequest& request) { return handle(request); }, http::HttpLimits{},
         &http_counters_);
     spdlog::info("metrics and control on http://{}:{}/metrics", config_.metrics.address,
                  endpoint_->port());
-    operator_view_->start_sampling([this](ViewSnapshot& out) { fill_view_snapshot(out); });
+    operator_view_->start_sampling([this](views::ServiceSnapshot& out) { fill_snapshot(out); });
     spdlog::info("live page on http://{}:{}/ ({:.1f} MB of trend history)", config_.metrics.address,
                  endpoint_->port(), static_cast<double>(operator_view_->history_bytes()) / 1e6);
   }
@@ -257,7 +264,7 @@ void Daemon::start() {
   if (!config_.recording.directory.empty()) {
     spdlog::info("recording raw samples under {}", config_.recording.directory);
   }
-  started_ns_ = monotonic_now_ns();
+  started_ns_ = realtime::monotonic_now_ns();
   last_state_save_ns_ = started_ns_;
   last_trend_save_ns_ = started_ns_;
 }
@@ -296,7 +303,7 @@ void Daemon::stop() {
   for (auto& driver : drivers_) driver->stop();
   stop_worker_.store(true, std::memory_order_release);
   if (worker_thread_.joinable()) worker_thread_.join();
-  worker_->drain(monotonic_now_ns());  // whatever the loops pushed last
+  worker_->drain(realtime::monotonic_now_ns());  // whatever the loops pushed last
   save_state(true);
   {
     // The last event: everything the loops, the worker and the state saving had to say is
@@ -308,7 +315,7 @@ void Daemon::stop() {
     event.pid = static_cast<long long>(::getpid());
     event.reason = stop_reason_;
     if (started_ns_ > 0) {
-      event.uptime_s = static_cast<double>(monotonic_now_ns() - started_ns_) / 1e9;
+      event.uptime_s = static_cast<double>(realtime::monotonic_now_ns() - started_ns_) / 1e9;
     }
     worker_->publish(event);
   }
@@ -326,11 +333,6 @@ void Daemon::stop() {
   worker_.reset();
   std::lock_guard lock(sinks_mutex_);
   sinks_.clear();
-}
-
-std::map<std::string, double> Daemon::state_saved_unix() const {
-  const std::lock_guard lock(state_saved_mutex_);
-  return state_saved_unix_;
 }
 
 bool Daemon::all_sources_ended() const {
@@ -369,7 +371,7 @@ void Daemon::housekeeping(std::int64_t now_ns) {
   // The end of each actuator's learning, once (a reload that relearns starts it again).
   for (const auto& status : worker_->status()) {
     bool& learning = learning_[status.name];
-    if (learning && !status.learning) spdlog::info("{}", learning_line(status));
+    if (learning && !status.learning) spdlog::info("{}", pipeline::learning_line(status));
     learning = status.learning;
   }
   // Overruns: at most one warning (and one event) per second for all groups.
@@ -436,7 +438,7 @@ void Daemon::reload() {
       sinks_.swap(sinks);  // the old sinks go only after the worker stopped using them
     }
     config_ = std::move(next);
-    if (operator_view_) operator_view_->set_ack_token(config_.metrics.ack_token);
+    set_ack_token(config_.metrics.ack_token);
     ++reloads_;
     last_reload_ok_ = true;
     event.kind = io::EventKind::config_reloaded;
@@ -475,13 +477,13 @@ int Daemon::run(double duration_s) {
       break;
     }
     if (signal == SIGHUP) reload();
-    housekeeping(monotonic_now_ns());
+    housekeeping(realtime::monotonic_now_ns());
     if (all_sources_ended()) {
       spdlog::info("every source has ended: stopping");
       stop_reason_ = "end_of_sources";
       break;
     }
-    if (deadline_ns > 0 && monotonic_now_ns() >= deadline_ns) {
+    if (deadline_ns > 0 && realtime::monotonic_now_ns() >= deadline_ns) {
       spdlog::info("--duration {} s reached: stopping", duration_s);
       stop_reason_ = "duration";
       break;
@@ -492,32 +494,107 @@ int Daemon::run(double duration_s) {
   return 0;
 }
 
-// One route per line: the path, its method, and what serves it (daemon/http_router.hpp answers
+// One route per line: the path, its method, and what serves it (http/http_router.hpp answers
 // 405 with Allow for another method on a known path, 404 for the rest).
-HttpResponse Daemon::handle(const HttpRequest& request) {
-  if (auto answer = operator_view_->handle(request)) return *answer;  // page, api, ack token
-  const HttpRoute routes[] = {
-      {"/metrics", "GET", [this](const HttpRequest&) { return metrics_response(); }},
-      {"/status", "GET", [this](const HttpRequest& r) { return status(r); }},
-      {"/ack", "POST", [this](const HttpRequest& r) { return acknowledge(r); }},
+http::HttpResponse Daemon::handle(const http::HttpRequest& request) {
+  if (auto answer = operator_view_->handle(request)) return *answer;  // the page and its api
+  const http::HttpRoute routes[] = {
+      {"/metrics", "GET", [this](const http::HttpRequest&) { return metrics(); }},
+      {"/status", "GET", [this](const http::HttpRequest& r) { return status(r); }},
+      {"/ack", "POST", [this](const http::HttpRequest& r) { return acknowledge(r); }},
   };
-  return route(routes, request);
+  return http::route(routes, request);
 }
 
-HttpResponse Daemon::metrics_response() const {
-  return {200, "text/plain; version=0.0.4; charset=utf-8", metrics_text()};
+void Daemon::set_ack_token(const std::string& token) {
+  {
+    const std::lock_guard lock(ack_token_mutex_);
+    ack_token_ = token;
+  }
+  if (operator_view_) operator_view_->set_ack_token_required(!token.empty());
 }
 
-HttpResponse Daemon::status(const HttpRequest& request) const {
+void Daemon::fill_actuators(views::ServiceSnapshot& out) const {
+  out.unix_time =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  worker_->status_into(out.actuators);
+  const std::lock_guard lock(state_saved_mutex_);
+  for (auto& a : out.actuators) {
+    const auto saved = state_saved_unix_.find(a.name);
+    a.learned_state_saved_unix =
+        saved == state_saved_unix_.end() ? std::numeric_limits<double>::quiet_NaN() : saved->second;
+  }
+}
+
+void Daemon::fill_snapshot(views::ServiceSnapshot& out) const {
+  const std::int64_t now_ns = realtime::monotonic_now_ns();
+  fill_actuators(out);
+  out.version = LEAKMON_VERSION;
+  out.config = config_path_;
+  out.uptime_s = static_cast<double>(now_ns - started_ns_) / 1e9;
+  out.reload.ok = last_reload_ok_.load();
+  out.reload.reloads = reloads_.load();
+  out.reload.failures = reload_failures_.load();
+  out.reload.last_unix = last_reload_unix_.load();
+  out.cpu_latency_request_held = cpu_latency_.held();
+  out.samples_processed = worker_->samples_processed();
+  out.events = worker_->events_published();
+  views::summarize(worker_->decision_latency(), out.decision_latency);
+  out.groups.resize(groups_.size());
+  for (std::size_t i = 0; i < groups_.size(); ++i) {
+    const Group& g = *groups_[i];
+    views::read_group(out.groups[i], g.config.name, g.loop->counters(), g.ring->capacity(),
+                      g.realtime.fifo, now_ns);
+  }
+  out.drivers.resize(drivers_.size());
+  for (std::size_t i = 0; i < drivers_.size(); ++i) {
+    out.drivers[i].name = drivers_[i]->name();
+    out.drivers[i].health = drivers_[i]->health();
+  }
+  // Outputs' own counters (io::EventSink::metrics), sorted by name: one family per name.
+  out.output_metrics.clear();
+  {
+    std::lock_guard lock(sinks_mutex_);
+    for (const auto& sink : sinks_) {
+      for (const auto& metric : sink->metrics()) {
+        out.output_metrics.push_back({std::string(sink->name()), metric});
+      }
+    }
+  }
+  std::stable_sort(out.output_metrics.begin(), out.output_metrics.end(),
+                   [](const auto& a, const auto& b) { return a.metric.name < b.metric.name; });
+  out.http.requests = http_counters_.requests.load();
+  out.http.rejected = http_counters_.rejected.load();
+  out.http.deadline_closes = http_counters_.deadline_closes.load();
+  out.http.open_connections = http_counters_.open_connections.load();
+}
+
+http::HttpResponse Daemon::metrics() const {
+  views::ServiceSnapshot snapshot;
+  fill_snapshot(snapshot);
+  return {200, "text/plain; version=0.0.4; charset=utf-8", views::metrics_text(snapshot)};
+}
+
+http::HttpResponse Daemon::status(const http::HttpRequest& request) const {
   const StatusFormat format = status_format(request);
   if (format.error) return *format.error;
-  if (format.text) return {200, "text/plain; charset=utf-8", status_text()};
-  return {200, "application/json", status_json()};
+  views::ServiceSnapshot snapshot;
+  fill_snapshot(snapshot);
+  const std::string json = views::status_json(snapshot);
+  if (format.text) return {200, "text/plain; charset=utf-8", views::status_text_from_json(json)};
+  return {200, "application/json", json};
 }
 
-// POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME. Anything else
-// acknowledges nothing (daemon/http_router.hpp ack_selection()).
-HttpResponse Daemon::acknowledge(const HttpRequest& request) {
+// POST /ack acknowledges every actuator; POST /ack?actuator=NAME only NAME, and with
+// metrics.ack_token set only with the token. Anything else acknowledges nothing
+// (daemon/routes.hpp).
+http::HttpResponse Daemon::acknowledge(const http::HttpRequest& request) {
+  std::string token;
+  {
+    const std::lock_guard lock(ack_token_mutex_);
+    token = ack_token_;
+  }
+  if (auto refusal = ack_refusal(request, token)) return *refusal;
   const AckSelection selection = ack_selection(request);
   if (selection.error) return *selection.error;
   const std::size_t matched = worker_->acknowledge(selection.actuator);

@@ -15,16 +15,17 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
-#include "daemon/cpu_latency_request.hpp"
-#include "daemon/http_endpoint.hpp"
-#include "daemon/operator_view.hpp"
 #include "daemon/service_notifier.hpp"
-#include "daemon/state_store.hpp"
-#include "daemon/worker.hpp"
+#include "http/http_endpoint.hpp"
 #include "io/driver.hpp"
 #include "io/event.hpp"
+#include "pipeline/state_store.hpp"
+#include "pipeline/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "realtime/cpu_latency_request.hpp"
+#include "views/operator_view.hpp"
+#include "views/snapshot.hpp"
 
 namespace leakmon::daemon {
 
@@ -40,21 +41,22 @@ class Daemon {
   // Throws config::ConfigError / io::DriverError when the configuration cannot start.
   int run(double duration_s = 0);
 
-  // Prometheus text exposition of everything the daemon counts (daemon/metrics_text.cpp).
-  std::string metrics_text() const;
-  // GET /status: the status as JSON, and the human summary made from it that `leakmon status`
-  // prints (daemon/status_json.cpp).
-  std::string status_json() const;
-  std::string status_text() const;
+  // The service's state as every view formats it (views/snapshot.hpp): into `out` in place, so
+  // that the live page's sampler refills a warm snapshot. Any thread; the worker's mutex is taken
+  // for the actuators, as it is for everything the worker shares.
+  void fill_snapshot(views::ServiceSnapshot& out) const;
+  // Its wall time and actuators only: what an output's feature message reads, from the output's
+  // own thread (no driver, output or HTTP counter is asked).
+  void fill_actuators(views::ServiceSnapshot& out) const;
 
  private:
   struct Group {
-    GroupConfig config;
+    pipeline::GroupConfig config;
     std::vector<io::Driver*> drivers;
-    std::unique_ptr<SpscRing<Sample>> ring;
-    std::unique_ptr<AcquisitionLoop> loop;
+    std::unique_ptr<realtime::SpscRing<realtime::Sample>> ring;
+    std::unique_ptr<realtime::AcquisitionLoop> loop;
     std::thread thread;
-    RealtimeReport realtime;
+    realtime::RealtimeReport realtime;
     std::atomic<bool> realtime_ready{false};
   };
   // The driver health last reported in an event (main thread only).
@@ -77,16 +79,15 @@ class Daemon {
   // The learned state; the page's trend too when `with_trend` (it is megabytes: written every
   // kTrendSaveSeconds and at shutdown, not with every state save).
   void save_state(bool with_trend);
-  // By actuator, when its learned state in the state directory was saved (for the metrics).
-  std::map<std::string, double> state_saved_unix() const;
   bool making_progress(std::int64_t now_ns);
   bool all_sources_ended() const;
-  HttpResponse handle(const HttpRequest& request);
-  // The live page's sample of the status (daemon/operator_view.cpp).
-  void fill_view_snapshot(ViewSnapshot& out) const;
-  HttpResponse acknowledge(const HttpRequest& request);
-  HttpResponse status(const HttpRequest& request) const;
-  HttpResponse metrics_response() const;
+  http::HttpResponse handle(const http::HttpRequest& request);
+  http::HttpResponse acknowledge(const http::HttpRequest& request);
+  // metrics.ack_token, which /ack asks for: set at start and by a reload (main thread), read by
+  // the HTTP threads.
+  void set_ack_token(const std::string& token);
+  http::HttpResponse status(const http::HttpRequest& request) const;
+  http::HttpResponse metrics() const;
 
   std::string config_path_;
   DaemonConfig config_;
@@ -94,18 +95,20 @@ class Daemon {
   std::vector<std::unique_ptr<Group>> groups_;
   std::vector<std::unique_ptr<io::EventSink>> sinks_;
   mutable std::mutex sinks_mutex_;  // a reload swaps sinks_ while /metrics reads them
-  std::unique_ptr<Worker> worker_;
+  std::unique_ptr<pipeline::Worker> worker_;
   std::thread worker_thread_;
-  std::unique_ptr<OperatorView> operator_view_;  // the live page; null without an endpoint
-  HttpCounters http_counters_;                   // before endpoint_: the endpoint counts into it
-  std::unique_ptr<HttpEndpoint> endpoint_;
-  std::unique_ptr<StateStore> state_store_;  // null when state.directory is empty
+  std::unique_ptr<views::OperatorView> operator_view_;  // the live page; null without an endpoint
+  http::HttpCounters http_counters_;  // before endpoint_: the endpoint counts into it
+  std::unique_ptr<http::HttpEndpoint> endpoint_;
+  std::unique_ptr<pipeline::StateStore> state_store_;  // null when state.directory is empty
   std::int64_t last_state_save_ns_ = 0;
   std::int64_t last_trend_save_ns_ = 0;
   static constexpr double kTrendSaveSeconds = 600.0;
   mutable std::mutex state_saved_mutex_;  // the main thread saves, the metrics thread reads
-  std::map<std::string, double> state_saved_unix_;
-  CpuLatencyRequest cpu_latency_;
+  std::map<std::string, double> state_saved_unix_;  // by actuator, when its state was saved
+  mutable std::mutex ack_token_mutex_;
+  std::string ack_token_;
+  realtime::CpuLatencyRequest cpu_latency_;
   ServiceNotifier notifier_;
   std::atomic<bool> stop_acquisition_{false};
   std::atomic<bool> stop_worker_{false};

@@ -1,6 +1,6 @@
 #include "daemon/output_registry.hpp"
 
-#include "daemon/event_log.hpp"
+#include "pipeline/event_log.hpp"
 #include "io/modbus/modbus_output.hpp"
 #include "io/mqtt/mqtt_output.hpp"
 
@@ -8,7 +8,7 @@ namespace leakmon::daemon {
 namespace {
 
 constexpr OutputType kOutputTypes[] = {
-    {"jsonl", make_jsonl_output},
+    {"jsonl", pipeline::make_jsonl_output},
     {"modbus", io::make_modbus_output},
     {"mqtt", io::mqtt::make_mqtt_output},
 };

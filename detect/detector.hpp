@@ -89,7 +89,7 @@ class Detector {
   // Whether it sees a leak only through the hydraulic mode in the chamber pressures (the ~75 Hz
   // resonance the level-2 details cover): then a rig whose mode does not show above the
   // transducers' noise gives it nothing to see, and the daemon says so
-  // (daemon/mode_visibility.hpp).
+  // (pipeline/mode_visibility.hpp).
   virtual bool needs_hydraulic_mode() const { return false; }
 };
 

@@ -11,8 +11,8 @@
 #include <span>
 #include <vector>
 
+#include "dsp/detail_feature.hpp"
 #include "dsp/dwt.hpp"
-#include "dsp/streaming_features.hpp"
 #include "dsp/wavelet.hpp"
 
 namespace leakmon::dsp {

@@ -11,26 +11,10 @@
 #include <string_view>
 #include <vector>
 
+#include "dsp/detail_feature.hpp"
 #include "dsp/mode.hpp"
 
 namespace leakmon::dsp {
-
-struct FeatureParams {
-  std::string wavelet = "db8";
-  int level = 2;
-  std::size_t window = 400;
-  std::size_t step = 20;
-  Mode mode = Mode::symmetric;
-};
-
-// Throws std::invalid_argument naming the offending parameter and the reason.
-void validate(const FeatureParams& params);
-
-struct DetailFeature {
-  double rms = std::numeric_limits<double>::quiet_NaN();
-  double energy = std::numeric_limits<double>::quiet_NaN();
-  bool valid = false;  // false: the window contained a gap (NaN sample)
-};
 
 class StreamingFeatures {
  public:

@@ -1,16 +1,16 @@
-// Fuzzes the HTTP request-target parser (daemon/http_target.cpp) with raw bytes as a peer would
+// Fuzzes the HTTP request-target parser (http/http_target.cpp) with raw bytes as a peer would
 // send them. Invariants: a parsed target's path starts with '/', no decoded name, value or path
 // holds a control character, the raw query is kept exactly, and percent-encoding each decoded
 // parameter and parsing again gives the same parameters (decoding loses nothing).
-// fuzz-sources: daemon/http_target.cpp
+// fuzz-sources: http/http_target.cpp
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
 
-#include "daemon/http_target.hpp"
+#include "http/http_target.hpp"
 
-using namespace leakmon::daemon;
+using namespace leakmon::http;
 
 namespace {
 

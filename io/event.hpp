@@ -37,7 +37,7 @@ enum class EventKind {
   // detects nothing until `protected_from`.
   relearning,
   // A pressure-only detector's rig: the hydraulic mode it sees a leak through hardly shows above
-  // the transducers' noise while it learns (daemon/mode_visibility.hpp), so no leak alarm can
+  // the transducers' noise while it learns (pipeline/mode_visibility.hpp), so no leak alarm can
   // come from it. Announced when learning ends and again after a restart.
   detection_blind,
 };
@@ -118,16 +118,12 @@ struct Event {
   double protected_from = kNoValue;
 };
 
-// One actuator's newest decision as an output may sample it (the snapshot /metrics reads).
+// One actuator's newest decision as an output may publish it: its feature message, one JSON
+// object the daemon formats from the same snapshot as /metrics and /status (views/status_json.hpp
+// features_json; fields in docs/daemon.md "Many rigs: MQTT").
 struct ActuatorReading {
   std::string actuator;
-  double t = kNoValue;      // source time of the decision [s]
-  double index = kNoValue;  // [Pa], the p1 channel's
-  double score = kNoValue;
-  double leak_lpm_per_mpa = kNoValue;  // at 40 degC when the oil temperature is known
-  double leak_lpm_per_mpa_ci95 = kNoValue;
-  std::string alarm_state;  // normal, raised, ... (daemon/alarm.hpp)
-  bool learning = true;
+  std::string message;
 };
 // Called from the output's own thread; takes the worker's lock briefly, never the real-time
 // path's. Empty when the daemon offers none.

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <ctime>
+#include <iterator>
 
 namespace leakmon::io {
 namespace {
@@ -57,6 +58,14 @@ void append_json_string(std::string& out, std::string_view text) {
   out += '"';
 }
 
+void append_json_number(std::string& out, double value) {
+  if (std::isfinite(value)) {
+    fmt::format_to(std::back_inserter(out), "{}", value);
+  } else {
+    out += "null";
+  }
+}
+
 std::string json_string(std::string_view text) {
   std::string out;
   append_json_string(out, text);
@@ -72,7 +81,7 @@ void JsonObject::string(std::string_view key_name, std::string_view value) {
 void JsonObject::number(std::string_view key_name, double value) {
   if (!std::isfinite(value)) return;
   key(key_name);
-  text_ += fmt::format("{}", value);
+  append_json_number(text_, value);
 }
 
 void JsonObject::boolean(std::string_view key_name, bool value) {

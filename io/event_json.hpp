@@ -19,6 +19,12 @@ std::string to_json_line(const Event& event);
 void append_json_string(std::string& out, std::string_view text);
 std::string json_string(std::string_view text);
 
+// `value` as a JSON number appended to `out`: the shortest text that reads back as the same
+// double, and `null` for NaN and infinities (JSON has neither). The one number writer of the
+// events, the outputs' messages and the daemon's JSON views; whether an unknown value is
+// written as null or left out is the object's choice (JsonObject leaves it out).
+void append_json_number(std::string& out, double value);
+
 // Builds a flat JSON object: strings escaped, empty strings and non-finite numbers left out.
 class JsonObject {
  public:

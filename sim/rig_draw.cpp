@@ -100,15 +100,6 @@ double max_step_amplitude(const Parameters& p) {
   return amplitude;
 }
 
-SensorSettings sensors_for(const Parameters& p) {
-  SensorSettings sensors;
-  for (const double range : {10e6, 20.7e6, 25e6, 35e6, 40e6, 60e6}) {
-    sensors.pressure_full_scale = range;
-    if (range >= 1.15 * p.ps) break;
-  }
-  return sensors;
-}
-
 Scenario other_rig_scenario(const OtherRig& rig, ControllerKind controller, double seconds,
                             std::uint64_t seed) {
   Scenario s;

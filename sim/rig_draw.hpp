@@ -49,10 +49,6 @@ double hydraulic_mode_hz(const Parameters& params);
 // half of it cannot be tracked).
 double max_step_amplitude(const Parameters& params);
 
-// MODEL.md's transducer chain ranged for the supply: the smallest of the usual ranges (10, 20.7,
-// 25, 35, 40, 60 MPa) that reads 1.15 x the supply; the paper's 20.7 MPa on the paper's rig.
-SensorSettings sensors_for(const Parameters& params);
-
 struct Viability {
   bool ok = false;
   bool saturated = false;  // refused for the command's saturation (a smaller step may pass)

@@ -9,7 +9,6 @@
 
 #include "capture/units.hpp"
 #include "config/yaml_reader.hpp"
-#include "sim/rig_draw.hpp"
 
 namespace leakmon::sim {
 namespace {

@@ -5,6 +5,15 @@
 
 namespace leakmon::sim {
 
+SensorSettings sensors_for(const Parameters& p) {
+  SensorSettings sensors;
+  for (const double range : {10e6, 20.7e6, 25e6, 35e6, 40e6, 60e6}) {
+    sensors.pressure_full_scale = range;
+    if (range >= 1.15 * p.ps) break;
+  }
+  return sensors;
+}
+
 double SensorSettings::pressure_lsb() const {
   return pressure_full_scale / std::ldexp(1.0, pressure_bits);
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "sim/effects.hpp"
+#include "sim/parameters.hpp"
 #include "sim/random.hpp"
 
 namespace leakmon::sim {
@@ -28,6 +29,10 @@ struct SensorSettings {
 
   double pressure_lsb() const;
 };
+
+// MODEL.md's transducer chain ranged for the supply: the smallest of the usual ranges (10, 20.7,
+// 25, 35, 40, 60 MPa) that reads 1.15 x the supply; the paper's 20.7 MPa on the paper's rig.
+SensorSettings sensors_for(const Parameters& params);
 
 // The quantisers of the chain (also used to re-quantise a spiked reading).
 double quantise_pressure(const SensorSettings& s, double p) noexcept;  // clamped to the range

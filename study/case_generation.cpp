@@ -6,7 +6,7 @@
 #include <cmath>
 #include <utility>
 
-#include "study/rig_cases.hpp"
+#include "sim/rig_draw.hpp"
 
 namespace leakmon::study {
 namespace {
@@ -347,6 +347,24 @@ double RunSpec::detection_deadline(double detect_within) const {
 
 std::uint64_t simulation_seed(std::uint64_t seed, int id) {
   return seed * 100003 + static_cast<std::uint64_t>(id);
+}
+
+// Seeds the rig drawer apart from the simulation's own streams.
+constexpr std::uint64_t kOtherRigSeed = 0x6f746865722d7267ULL;  // "other-rg"
+
+void use_other_rig(RunSpec& run) {
+  sim::Scenario& s = run.scenario;
+  const sim::OtherRig other = sim::draw_other_rig(s.seed ^ kOtherRigSeed, s.controller);
+  s.rig = other.rig;
+  s.params = other.rig.params;
+  s.conditions.oil = other.rig.oil;
+  s.reference = other.reference;
+  s.sensors = other.sensors;
+  s.name += "-other-rig";
+  if (run.leak > 0.0) {
+    run.leak *= s.params.Kv / kPaperValveCoefficient;
+    if (s.effects.internal_leakage) s.effects.internal_leakage->C_L = run.leak;
+  }
 }
 
 RunSpec generate_case(int id, std::uint64_t seed, const Condition& condition,

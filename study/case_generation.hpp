@@ -118,6 +118,14 @@ std::vector<Condition> plan_conditions(const EvaluationOptions& options);
 // Seed of run `id`'s simulation (noise, reference) in a study with master seed `seed`.
 std::uint64_t simulation_seed(std::uint64_t seed, int id);
 
+// MODEL.md's Kv of the paper's valve: leak sizes on other rigs are stated relative to it.
+inline constexpr double kPaperValveCoefficient = 3.39e-7;
+
+// The case generator's hook for `--rigs other`: the run's rig (description, plant, oil,
+// reference, transducers) becomes one drawn by sim::draw_other_rig for the run's controller,
+// seeded by the run's seed; its leak (and onset, duration, effects) stays, scaled to the valve.
+void use_other_rig(RunSpec& run);
+
 // The scenario of run `id` under `condition`. The rig (controller, spring, beta, Kv, m, b,
 // reference amplitude) and the onset are drawn from `rig_draws`, the study's one stream shared
 // by all runs in order, so a master seed reproduces every run; `seed` seeds the simulation.

@@ -15,7 +15,7 @@
 #include <thread>
 #include <utility>
 
-#include "daemon/replay.hpp"
+#include "pipeline/replay.hpp"
 #include "detect/factory.hpp"
 #include "sim/random.hpp"
 #include "sim/sensor_faults.hpp"
@@ -84,7 +84,7 @@ double first_spike(const sim::Scenario& scenario) {
 
 // Alarms of one replay into `result`, their times shifted by `offset` (a restarted replay's
 // clock starts at the restart).
-void collect_alarms(const daemon::ReplayResult& replay, double offset, RunResult& result) {
+void collect_alarms(const pipeline::ReplayResult& replay, double offset, RunResult& result) {
   const auto all = candidates();
   std::map<std::string, std::pair<std::size_t, std::size_t>> by_name;
   for (std::size_t c = 0; c < all.size(); ++c) {
@@ -123,25 +123,26 @@ config::ConfigNode detector_options(const EvaluationOptions& options) {
                                          "leakmon evaluate");
 }
 
-daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
+pipeline::DaemonConfig evaluation_config(const capture::Capture& capture,
                                        const EvaluationOptions& options) {
-  daemon::DaemonConfig config = daemon::default_replay_config(capture);
-  const daemon::ActuatorConfig base = config.actuators.at(0);
+  pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
+  const pipeline::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
   const auto detector_config = detector_options(options);
   const auto all = candidates();
   for (std::size_t c = 0; c < all.size(); ++c) {
     const Candidate& candidate = all[c];
     for (std::size_t t = 0; t < candidate.raise_thresholds.size(); ++t) {
-      daemon::ActuatorConfig a = base;
+      pipeline::ActuatorConfig a = base;
       a.name = actuator_name(c, t);
       a.detector = candidate.kind;
       a.detector_options = detector_config;
-      if (!candidate.p2) a.p2 = {};
-      if (!candidate.u) a.u = {};
-      if (!candidate.x) a.x = {};
-      if (!candidate.temp) a.temp = {};
-      a.ps = {};  // the detectors read the supply from the chamber pressures at rest
+      if (!candidate.p2) a.channels[capture::Role::p2] = {};
+      if (!candidate.u) a.channels[capture::Role::u] = {};
+      if (!candidate.x) a.channels[capture::Role::x] = {};
+      if (!candidate.temp) a.channels[capture::Role::temp] = {};
+      a.channels[capture::Role::ps] =
+          {};  // the detectors read the supply from the chamber pressures at rest
       const double raise = candidate.raise_thresholds[t];
       a.alarm.raise_threshold = raise;
       a.alarm.clear_threshold =
@@ -167,7 +168,7 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
     capture::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
   }
   if (!spec.after_restart) {
-    collect_alarms(daemon::replay_capture(capture, evaluation_config(capture, options)), 0.0,
+    collect_alarms(pipeline::replay_capture(capture, evaluation_config(capture, options)), 0.0,
                    result);
     if (spec.leak > 0.0 && !spec.wear_run()) {
       result.size_check = check_size(capture, spec, options, detector_options(options));
@@ -180,11 +181,11 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
   // at the end, as at shutdown), the second as the daemon started again on that state.
   const std::filesystem::path directory = state_directory(spec);
   std::filesystem::remove_all(directory);
-  daemon::ReplayOptions replay_options;
+  pipeline::ReplayOptions replay_options;
   replay_options.state_directory = directory.string();
   try {
     collect_alarms(
-        daemon::replay_capture(capture, evaluation_config(capture, options), replay_options), 0.0,
+        pipeline::replay_capture(capture, evaluation_config(capture, options), replay_options), 0.0,
         result);
     const capture::Capture after = sim::simulate(*spec.after_restart);
     if (std::find(options.keep_captures.begin(), options.keep_captures.end(), spec.id) !=
@@ -192,8 +193,9 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
       capture::write_capture((options.out / fmt::format("run-{}-restarted.csv", spec.id)).string(),
                              after);
     }
-    collect_alarms(daemon::replay_capture(after, evaluation_config(after, options), replay_options),
-                   spec.restart_at, result);
+    collect_alarms(
+        pipeline::replay_capture(after, evaluation_config(after, options), replay_options),
+        spec.restart_at, result);
     result.seconds = spec.restart_at + spec.after_restart->duration_s;
   } catch (...) {
     std::filesystem::remove_all(directory);

@@ -1,5 +1,5 @@
 // Runs the evaluation's cases: each RunSpec simulated (sim/) and replayed in process through
-// exactly the daemon's pipeline (daemon::replay_capture), every candidate at every threshold
+// exactly the daemon's pipeline (pipeline::replay_capture), every candidate at every threshold
 // one actuator of the replayed configuration, so one replay yields the whole ROC sweep.
 #pragma once
 
@@ -10,7 +10,7 @@
 
 #include "capture/capture.hpp"
 #include "config/yaml_reader.hpp"
-#include "daemon/config.hpp"
+#include "pipeline/config.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
 
@@ -54,7 +54,7 @@ struct RunResult {
 config::ConfigNode detector_options(const EvaluationOptions& options);
 
 // The daemon configuration that replays `capture`: one actuator per candidate and threshold.
-daemon::DaemonConfig evaluation_config(const capture::Capture& capture,
+pipeline::DaemonConfig evaluation_config(const capture::Capture& capture,
                                        const EvaluationOptions& options);
 
 // Simulates and replays one run (and writes its capture when options.keep_captures names it).

@@ -11,8 +11,8 @@
 #include <thread>
 #include <variant>
 
-#include "daemon/mode_visibility.hpp"
-#include "daemon/replay.hpp"
+#include "pipeline/mode_visibility.hpp"
+#include "pipeline/replay.hpp"
 #include "sim/rig_draw.hpp"
 #include "sim/simulate.hpp"
 #include "study/evaluation_summary.hpp"
@@ -20,8 +20,6 @@
 namespace leakmon::study {
 namespace {
 
-// Seeds the rig drawer apart from the simulation's own streams.
-constexpr std::uint64_t kOtherRigSeed = 0x6f746865722d7267ULL;  // "other-rg"
 // The rate and level the replayed actuators' index uses (the daemon's defaults).
 constexpr double kSampleRateHz = 500.0;
 constexpr int kIndexLevel = 2;
@@ -60,21 +58,6 @@ std::string size_error_text(const Rates& r) {
 
 }  // namespace
 
-void use_other_rig(RunSpec& run) {
-  sim::Scenario& s = run.scenario;
-  const sim::OtherRig other = sim::draw_other_rig(s.seed ^ kOtherRigSeed, s.controller);
-  s.rig = other.rig;
-  s.params = other.rig.params;
-  s.conditions.oil = other.rig.oil;
-  s.reference = other.reference;
-  s.sensors = other.sensors;
-  s.name += "-other-rig";
-  if (run.leak > 0.0) {
-    run.leak *= s.params.Kv / kPaperValveCoefficient;
-    if (s.effects.internal_leakage) s.effects.internal_leakage->C_L = run.leak;
-  }
-}
-
 double paper_equivalent_leak(const RunSpec& run) {
   const auto* leak = std::get_if<LeakCondition>(&run.condition.kind);
   return leak != nullptr ? leak->coefficient : 0.0;
@@ -90,10 +73,10 @@ std::vector<RigCandidate> rig_candidates() {
   return out;
 }
 
-daemon::DaemonConfig rig_evaluation_config(const capture::Capture& capture, const RunSpec& run,
-                                           const EvaluationOptions& options) {
-  daemon::DaemonConfig config = daemon::default_replay_config(capture);
-  const daemon::ActuatorConfig base = config.actuators.at(0);
+pipeline::DaemonConfig rig_evaluation_config(const capture::Capture& capture, const RunSpec& run,
+                                             const EvaluationOptions& options) {
+  pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
+  const pipeline::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
   // The run's transducers, for both classes: a user who has not described the rig still knows
   // the range of the transducers they fitted.
@@ -107,18 +90,18 @@ daemon::DaemonConfig rig_evaluation_config(const capture::Capture& capture, cons
   position.noise_sigma = sensors.position_noise_sigma;
   const auto all = rig_candidates();
   for (std::size_t c = 0; c < all.size(); ++c) {
-    daemon::ActuatorConfig a = base;
+    pipeline::ActuatorConfig a = base;
     a.name = actuator_of(c);
     a.detector = "default";
     a.detector_options = detector_options(options);
-    if (!all[c].p2) a.p2 = {};
-    if (!all[c].u) a.u = {};
-    if (!all[c].x) a.x = {};
-    a.temp = {};
-    a.ps = {};
-    if (all[c].told) daemon::apply_rig(a, run.scenario.rig);
-    a.p1_transducer = a.p2_transducer = pressure;
-    a.x_transducer = position;
+    if (!all[c].p2) a.channels[capture::Role::p2] = {};
+    if (!all[c].u) a.channels[capture::Role::u] = {};
+    if (!all[c].x) a.channels[capture::Role::x] = {};
+    a.channels[capture::Role::temp] = {};
+    a.channels[capture::Role::ps] = {};
+    if (all[c].told) pipeline::apply_rig(a, run.scenario.rig);
+    a.transducers[capture::Role::p1] = a.transducers[capture::Role::p2] = pressure;
+    a.transducers[capture::Role::x] = position;
     config.actuators.push_back(std::move(a));
   }
   return config;
@@ -137,7 +120,7 @@ RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& opti
   result.blind.assign(all.size(), false);
   result.any_fault.assign(all.size(), false);
   result.mode_hz = sim::hydraulic_mode_hz(spec.scenario.params);
-  const auto band = daemon::ModeVisibilityCheck::readable_band(kSampleRateHz, kIndexLevel);
+  const auto band = pipeline::ModeVisibilityCheck::readable_band(kSampleRateHz, kIndexLevel);
   result.mode_in_band = result.mode_hz >= band.low && result.mode_hz <= band.high;
   result.rest_load = rest_load_pressure(spec.scenario);
 
@@ -147,7 +130,7 @@ RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& opti
     capture::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
   }
   const auto replay =
-      daemon::replay_capture(capture, rig_evaluation_config(capture, spec, options));
+      pipeline::replay_capture(capture, rig_evaluation_config(capture, spec, options));
   for (const auto& event : replay.events) {
     const std::size_t c = candidate_of(event.actuator, all.size());
     if (c >= all.size()) continue;
@@ -232,7 +215,7 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
   for (std::size_t c = 0; c < all.size(); ++c) {
     scores.push_back(score_rig_candidate(results, c, options));
   }
-  const auto band = daemon::ModeVisibilityCheck::readable_band(kSampleRateHz, kIndexLevel);
+  const auto band = pipeline::ModeVisibilityCheck::readable_band(kSampleRateHz, kIndexLevel);
 
   auto md = fmt::output_file((dir / "rigs.md").string());
   md.print(
@@ -262,7 +245,7 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
              s.sensor_fault_runs);
   }
   md.print(
-      "\nThe index reads modes within {:.1f}-{:.1f} Hz (daemon::ModeVisibilityCheck::"
+      "\nThe index reads modes within {:.1f}-{:.1f} Hz (pipeline::ModeVisibilityCheck::"
       "readable_band); the detection_blind column counts the runs whose pressure-only actuator "
       "announced it. Rest load: K_s a / A at the steps' mean amplitude a, what a leak flows on "
       "while the flow balance judges it.\n\nRigs drawn:\n\n| run | controller | bore mm | supply "

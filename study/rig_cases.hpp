@@ -13,21 +13,13 @@
 #include <vector>
 
 #include "capture/capture.hpp"
-#include "daemon/config.hpp"
+#include "pipeline/config.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
 #include "study/evaluation_runner.hpp"
 #include "study/evaluation_summary.hpp"
 
 namespace leakmon::study {
-
-// MODEL.md's Kv of the paper's valve: leak sizes on other rigs are stated relative to it.
-inline constexpr double kPaperValveCoefficient = 3.39e-7;
-
-// The case generator's hook for `--rigs other`: the run's rig (description, plant, oil,
-// reference, transducers) becomes one drawn by sim::draw_other_rig for the run's controller,
-// seeded by the run's seed; its leak (and onset, duration, effects) stays, scaled to the valve.
-void use_other_rig(RunSpec& run);
 
 // The leak size the run's condition names, before scaling to the valve (0 for a healthy run).
 double paper_equivalent_leak(const RunSpec& run);
@@ -42,8 +34,8 @@ std::vector<RigCandidate> rig_candidates();
 
 // The replay configuration: one actuator per rig candidate ("r0", "r1", ...) at its detector's
 // own thresholds, transducers as the run's (range, resolution, noise), `rig:` for the told ones.
-daemon::DaemonConfig rig_evaluation_config(const capture::Capture& capture, const RunSpec& run,
-                                           const EvaluationOptions& options);
+pipeline::DaemonConfig rig_evaluation_config(const capture::Capture& capture, const RunSpec& run,
+                                             const EvaluationOptions& options);
 
 // The load pressure the spring holds at rest at the steps' mean amplitude, K_s a / A [Pa]: what a
 // leak flows on while the flow balance judges it. MODEL.md ("Test programs"): below about 1 MPa a
@@ -55,7 +47,7 @@ struct RigRunResult {
   // alarms[candidate][0]: the internal_leakage raises of each rig candidate (add_run's layout).
   RunResult run;
   double mode_hz = 0.0;         // sim::hydraulic_mode_hz of the simulated plant
-  bool mode_in_band = false;    // within daemon::ModeVisibilityCheck::readable_band at 500 Hz
+  bool mode_in_band = false;    // within pipeline::ModeVisibilityCheck::readable_band at 500 Hz
   double rest_load = 0.0;       // rest_load_pressure [Pa]
   std::vector<bool> blind;      // per candidate: it announced detection_blind
   std::vector<bool> any_fault;  // per candidate: it raised a sensor_fault alarm

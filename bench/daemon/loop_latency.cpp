@@ -13,12 +13,12 @@
 #include <thread>
 
 #include "config/yaml_reader.hpp"
-#include "daemon/acquisition_loop.hpp"
 #include "daemon/config.hpp"
-#include "daemon/cpu_latency_request.hpp"
-#include "daemon/event_log.hpp"
-#include "daemon/worker.hpp"
 #include "io/sim/sim_driver.hpp"
+#include "pipeline/event_log.hpp"
+#include "pipeline/worker.hpp"
+#include "realtime/acquisition_loop.hpp"
+#include "realtime/cpu_latency_request.hpp"
 
 using namespace leakmon;
 
@@ -46,33 +46,33 @@ int main(int argc, char** argv) {
   const auto config = daemon::parse_config(config::ConfigNode::load_string(yaml, "bench.yaml"));
   std::vector<std::unique_ptr<io::Driver>> drivers;
   std::vector<io::Driver*> raw;
-  std::vector<daemon::ChannelRef> channels;
+  std::vector<pipeline::ChannelRef> channels;
   for (const auto& d : config.drivers) {
     drivers.push_back(io::make_sim_driver(*d.node));
     drivers.back()->start();
     raw.push_back(drivers.back().get());
     for (const auto& c : drivers.back()->channels()) channels.push_back({d.name, c, std::nullopt});
   }
-  const std::string lock_warning = daemon::lock_process_memory();
-  daemon::CpuLatencyRequest cpu_latency;
-  if (cpu_wakeup_us >= 0) cpu_latency = daemon::CpuLatencyRequest(cpu_wakeup_us);
-  daemon::SpscRing<daemon::Sample> ring(8192);
-  daemon::AcquisitionLoop loop(period_ns, raw, ring);
-  daemon::CollectingEventSink events;
-  daemon::Worker worker(config, {daemon::GroupInput{"main", &ring, channels, period_ns}},
-                        {&events});
+  const std::string lock_warning = realtime::lock_process_memory();
+  realtime::CpuLatencyRequest cpu_latency;
+  if (cpu_wakeup_us >= 0) cpu_latency = realtime::CpuLatencyRequest(cpu_wakeup_us);
+  realtime::SpscRing<realtime::Sample> ring(8192);
+  realtime::AcquisitionLoop loop(period_ns, raw, ring);
+  pipeline::CollectingEventSink events;
+  pipeline::Worker worker(config, {pipeline::GroupInput{"main", &ring, channels, period_ns}},
+                          {&events});
 
   std::atomic<bool> stop{false};
-  daemon::RealtimeReport report;
+  realtime::RealtimeReport report;
   std::thread acquisition([&] {
-    report = daemon::make_thread_realtime(priority, {});
+    report = realtime::make_thread_realtime(priority, {});
     loop.run(stop);
   });
   std::atomic<bool> stop_worker{false};
   std::thread consumer([&] {
-    daemon::make_thread_realtime(config.worker_priority, {});
+    realtime::make_thread_realtime(config.worker_priority, {});
     while (!stop_worker.load()) {
-      if (worker.drain(daemon::monotonic_now_ns()) == 0) {
+      if (worker.drain(realtime::monotonic_now_ns()) == 0) {
         std::this_thread::sleep_for(std::chrono::nanoseconds(config.worker_poll_ns));
       }
     }

@@ -5,13 +5,13 @@
 #include <cstdint>
 #include <thread>
 
-#include "daemon/sample.hpp"
-#include "daemon/spsc_ring.hpp"
+#include "realtime/sample.hpp"
+#include "realtime/spsc_ring.hpp"
 
 namespace {
 
-using leakmon::daemon::Sample;
-using leakmon::daemon::SpscRing;
+using leakmon::realtime::Sample;
+using leakmon::realtime::SpscRing;
 
 template <typename T>
 void transfer(benchmark::State& state) {

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The rigs behind docs/detection.md's table "A rig the pressures cannot see a leak on": for each,
 `leakmon sim` (1200 s, seed 23) and the p1 index over the noise floor the daemon's
-detection_blind check uses (daemon/mode_visibility.hpp: 5 kPa noise and a 12-bit LSB over
+detection_blind check uses (pipeline/mode_visibility.hpp: 5 kPa noise and a 12-bit LSB over
 20.7 MPa, 5.2 kPa). The index is the paper's, with PyWavelets (db8, level 2, symmetric, 400
 samples every 200). It prints the range of its 300 s medians over the run, and whether
 `leakmon replay` with p1 and p2 only wrote detection_blind.

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """How often a capture's samples repeat the one before exactly on every channel of a set (the
-quantity daemon/repeated_samples.hpp judges; docs/daemon.md "Events"): per column set, the share
+quantity pipeline/repeated_samples.hpp judges; docs/daemon.md "Events"): per column set, the share
 of repeating samples and the most of them in any 500-sample window (the daemon holds the leak
 decision from 100).
 Usage: repeated_samples.py CAPTURE.csv ...   (e.g. `leakmon sim --preset healthy --seed 5 ...`)"""

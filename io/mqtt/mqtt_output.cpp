@@ -458,22 +458,8 @@ class MqttOutput final : public EventSink {
       features_dropped_.fetch_add(readings.size(), std::memory_order_relaxed);
       return;
     }
-    timespec now{};
-    clock_gettime(CLOCK_REALTIME, &now);
-    const double unix_time =
-        static_cast<double>(now.tv_sec) + static_cast<double>(now.tv_nsec) * 1e-9;
     for (const auto& r : readings) {
-      JsonObject json;
-      json.number("t", r.t);
-      json.string("actuator", r.actuator);
-      json.number("index", r.index / 1e3);
-      json.number("score", r.score);
-      json.number("leak_lpm_per_mpa", r.leak_lpm_per_mpa);
-      json.number("leak_lpm_per_mpa_ci95", r.leak_lpm_per_mpa_ci95);
-      json.string("alarm_state", r.alarm_state);
-      json.boolean("learning", r.learning);
-      json.number("unix_time", unix_time);
-      const std::string payload = json.finish();
+      const std::string& payload = r.message;
       const std::string topic = settings_.topic + "/" + topic_level(r.actuator) + "/features";
       const int rc = mosquitto_publish(mosq_, nullptr, topic.c_str(),
                                        static_cast<int>(payload.size()), payload.data(), 0, false);

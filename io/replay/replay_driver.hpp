@@ -26,7 +26,7 @@ class ReplayDriver final : public Driver {
  public:
   // From a file: reads the header now (channels are known at once), the rows in start().
   explicit ReplayDriver(ReplaySettings settings);
-  // From a capture already in memory (the in-process replay of daemon/replay.hpp).
+  // From a capture already in memory (the in-process replay of pipeline/replay.hpp).
   ReplayDriver(ReplaySettings settings, std::shared_ptr<const capture::Capture> capture);
 
   const std::string& name() const override { return settings_.name; }

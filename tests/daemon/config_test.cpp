@@ -17,6 +17,8 @@
 namespace leakmon::daemon {
 namespace {
 
+using capture::Role;
+
 std::string error_of(const std::string& yaml) {
   try {
     parse_config(config::ConfigNode::load_string(yaml, "rig.yaml"));
@@ -36,10 +38,10 @@ TEST(DaemonConfig, MinimalConfigGetsTheDocumentedDefaults) {
   EXPECT_EQ(config.groups[0].priority, 80);
   EXPECT_EQ(config.groups[0].drivers, std::vector<std::string>{"rig"});
   const auto& a = config.actuators.at(0);
-  EXPECT_EQ(a.p1.driver, "rig");
-  EXPECT_EQ(a.p1.channel, "p1");
-  EXPECT_EQ(a.x.channel, "x");
-  EXPECT_FALSE(a.p2.present());
+  EXPECT_EQ(a.channels[Role::p1].driver, "rig");
+  EXPECT_EQ(a.channels[Role::p1].channel, "p1");
+  EXPECT_EQ(a.channels[Role::x].channel, "x");
+  EXPECT_FALSE(a.channels[Role::p2].present());
   EXPECT_EQ(a.features.window, 400u);
   EXPECT_EQ(a.detector, "default");
   EXPECT_TRUE(std::isnan(a.alarm.raise_threshold)) << "left to the detector";
@@ -364,13 +366,13 @@ TEST(DaemonConfig, AnActuatorsRigIsReadAndSetsTheTransducersRange) {
   EXPECT_DOUBLE_EQ(a.rig.params.Kv, 5.3e-7);
   EXPECT_EQ(a.rig.source, "rig.yaml:5:10");
   // 21 MPa: the 25 MPa range (sim::sensors_for), 12 bit, for both chambers.
-  EXPECT_DOUBLE_EQ(a.p1_transducer.max, 25e6);
-  EXPECT_DOUBLE_EQ(a.p2_transducer.resolution, 25e6 / 4096.0);
+  EXPECT_DOUBLE_EQ(a.transducers[capture::Role::p1].max, 25e6);
+  EXPECT_DOUBLE_EQ(a.transducers[capture::Role::p2].resolution, 25e6 / 4096.0);
   // A configured transducer range wins; without a rig, MODEL.md's 20.7 MPa.
-  EXPECT_DOUBLE_EQ(config.actuators.at(1).p1_transducer.max, 40e6);
-  EXPECT_DOUBLE_EQ(config.actuators.at(1).p2_transducer.max, 25e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).transducers[capture::Role::p1].max, 40e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(1).transducers[capture::Role::p2].max, 25e6);
   EXPECT_TRUE(config.actuators.at(2).rig.nominal());
-  EXPECT_DOUBLE_EQ(config.actuators.at(2).p1_transducer.max, 20.7e6);
+  EXPECT_DOUBLE_EQ(config.actuators.at(2).transducers[capture::Role::p1].max, 20.7e6);
   EXPECT_TRUE(config.warnings.empty());
 
   const std::string e = error_of(std::string(kDriver) +

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "capture/capture.hpp"
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -70,14 +70,14 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   ASSERT_TRUE(test::eventually(
       [&] {
         try {
-          return http_request("127.0.0.1", port, "GET", "/status").status == 200;
+          return http::http_request("127.0.0.1", port, "GET", "/status").status == 200;
         } catch (const std::exception&) {
           return false;
         }
       },
       10s))
       << daemon.log();
-  const auto metrics = http_request("127.0.0.1", port, "GET", "/metrics").body;
+  const auto metrics = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
   EXPECT_NE(metrics.find("leakmon_build_info{version="), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_ring_drops_total{group=\"main\"}"), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_loop_wakeup_latency_seconds_bucket"), std::string::npos);
@@ -88,9 +88,9 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   EXPECT_NE(
       metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"x\",status=\"failure\"} 0"),
       std::string::npos);
-  EXPECT_NE(
-      http_request("127.0.0.1", port, "GET", "/status?format=text").body.find("channel p2: ok"),
-      std::string::npos);
+  EXPECT_NE(http::http_request("127.0.0.1", port, "GET", "/status?format=text")
+                .body.find("channel p2: ok"),
+            std::string::npos);
 
   // A valid change applies; a broken file is rejected with its location and changes nothing.
   const std::string events = dir + "/events.jsonl";
@@ -109,7 +109,7 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   EXPECT_NE(test::DaemonProcess::read_file(events).find("leakmon.yaml:6:29:"), std::string::npos)
       << "the rejection names file and line";
   EXPECT_TRUE(daemon.running());
-  EXPECT_NE(http_request("127.0.0.1", port, "GET", "/metrics")
+  EXPECT_NE(http::http_request("127.0.0.1", port, "GET", "/metrics")
                 .body.find("leakmon_config_reload_success 0"),
             std::string::npos);
 
@@ -117,9 +117,9 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   ASSERT_TRUE(test::eventually(
       [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_raised") >= 1; }, 25s))
       << daemon.log();
-  const auto ack = http_request("127.0.0.1", port, "POST", "/ack?actuator=cyl");
+  const auto ack = http::http_request("127.0.0.1", port, "POST", "/ack?actuator=cyl");
   EXPECT_EQ(ack.status, 200) << ack.body;
-  EXPECT_EQ(http_request("127.0.0.1", port, "POST", "/ack?actuator=nobody").status, 404);
+  EXPECT_EQ(http::http_request("127.0.0.1", port, "POST", "/ack?actuator=nobody").status, 404);
   ASSERT_TRUE(test::eventually(
       [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_acknowledged") == 1; },
       5s));

@@ -12,9 +12,9 @@
 #include <fstream>
 #include <string>
 
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "tests/daemon/daemon_process.hpp"
-#include "tests/daemon/raw_http.hpp"
+#include "tests/http/raw_http.hpp"
 
 namespace leakmon::daemon {
 namespace {
@@ -24,7 +24,7 @@ using namespace std::chrono_literals;
 // For requests http_request() cannot send (oversized, many headers, odd methods).
 const auto status_line = test::raw_http_status_line;
 
-std::string header_value(const HttpResponse& response, const std::string& name) {
+std::string header_value(const http::HttpResponse& response, const std::string& name) {
   for (const auto& [key, value] : response.headers) {
     if (key == name) return value;
   }
@@ -32,13 +32,13 @@ std::string header_value(const HttpResponse& response, const std::string& name) 
 }
 
 // The alarm state of the only actuator, from the JSON status (the text between the quotes
-// after "alarms":[{"name":"...","state":").
+// after "alarm_state":").
 std::string alarm_state(int port) {
-  const std::string body = http_request("127.0.0.1", port, "GET", "/status").body;
-  const auto alarms = body.find("\"alarms\":[");
-  const auto key = body.find("\"state\":\"", alarms);
-  if (alarms == std::string::npos || key == std::string::npos) return "(no status)";
-  const auto start = key + 9;
+  const std::string body = http::http_request("127.0.0.1", port, "GET", "/status").body;
+  const std::string_view key = "\"alarm_state\":\"";
+  const auto at = body.find(key);
+  if (at == std::string::npos) return "(no status)";
+  const auto start = at + key.size();
   return body.substr(start, body.find('"', start) - start);
 }
 
@@ -68,7 +68,7 @@ TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
   ASSERT_TRUE(test::eventually(
       [&] {
         try {
-          return http_request("127.0.0.1", port, "GET", "/metrics").status == 200;
+          return http::http_request("127.0.0.1", port, "GET", "/metrics").status == 200;
         } catch (const std::exception&) {
           return false;
         }
@@ -77,21 +77,21 @@ TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
       << daemon.log();
 
   // Methods: 405 with Allow on known paths, HEAD like GET without a body, 404 elsewhere.
-  const HttpResponse post_metrics = http_request("127.0.0.1", port, "POST", "/metrics");
+  const http::HttpResponse post_metrics = http::http_request("127.0.0.1", port, "POST", "/metrics");
   EXPECT_EQ(post_metrics.status, 405);
   EXPECT_EQ(header_value(post_metrics, "allow"), "GET, HEAD");
-  const HttpResponse get_ack = http_request("127.0.0.1", port, "GET", "/ack");
+  const http::HttpResponse get_ack = http::http_request("127.0.0.1", port, "GET", "/ack");
   EXPECT_EQ(get_ack.status, 405);
   EXPECT_EQ(header_value(get_ack, "allow"), "POST");
-  const HttpResponse head = http_request("127.0.0.1", port, "HEAD", "/metrics");
+  const http::HttpResponse head = http::http_request("127.0.0.1", port, "HEAD", "/metrics");
   EXPECT_EQ(head.status, 200);
   EXPECT_TRUE(head.body.empty());
-  EXPECT_EQ(http_request("127.0.0.1", port, "GET", "/nothing").status, 404);
-  const HttpResponse status = http_request("127.0.0.1", port, "GET", "/status");
+  EXPECT_EQ(http::http_request("127.0.0.1", port, "GET", "/nothing").status, 404);
+  const http::HttpResponse status = http::http_request("127.0.0.1", port, "GET", "/status");
   EXPECT_EQ(status.content_type, "application/json");
   EXPECT_EQ(status.body.find("nan"), std::string::npos) << status.body;
   EXPECT_EQ(status.body.find("NaN"), std::string::npos) << status.body;
-  EXPECT_EQ(http_request("127.0.0.1", port, "GET", "/status?format=yaml").status, 400);
+  EXPECT_EQ(http::http_request("127.0.0.1", port, "GET", "/status?format=yaml").status, 400);
 
   // Sizes: request line (414), header count and size (431), body (413).
   EXPECT_NE(
@@ -122,11 +122,11 @@ TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
                                                {"/ack?actuator=cylinder&actuator=cylinder", 400},
                                                {"/ack?actuator=cylinder&x=1", 400}};
   for (const auto& [target, code] : typos) {
-    EXPECT_EQ(http_request("127.0.0.1", port, "POST", target).status, code) << target;
+    EXPECT_EQ(http::http_request("127.0.0.1", port, "POST", target).status, code) << target;
   }
   EXPECT_EQ(alarm_state(port), "active_unacknowledged");
-  const HttpResponse ack =
-      http_request("127.0.0.1", port, "POST", "/ack?actuator=" + percent_encode("cylinder"));
+  const http::HttpResponse ack = http::http_request(
+      "127.0.0.1", port, "POST", "/ack?actuator=" + http::percent_encode("cylinder"));
   EXPECT_EQ(ack.status, 200) << ack.body;
   EXPECT_EQ(alarm_state(port), "active_acknowledged");
 

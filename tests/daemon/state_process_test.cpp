@@ -11,7 +11,7 @@
 #include <fstream>
 
 #include "capture/capture.hpp"
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/daemon/daemon_process.hpp"
@@ -60,7 +60,7 @@ DaemonRun run_daemon(const std::string& dir, int port, const std::string& name) 
   test::eventually(
       [&] {
         try {
-          const auto body = http_request("127.0.0.1", port, "GET", "/metrics").body;
+          const auto body = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
           const auto pos = body.find("leakmon_detector_learning{");
           if (pos == std::string::npos) return false;
           run.learning_metric = body.substr(pos, body.find('\n', pos) - pos);
@@ -73,7 +73,7 @@ DaemonRun run_daemon(const std::string& dir, int port, const std::string& name) 
   test::eventually(
       [&] {
         try {
-          run.trend = http_request("127.0.0.1", port, "GET", "/api/trend").body;
+          run.trend = http::http_request("127.0.0.1", port, "GET", "/api/trend").body;
           return run.trend.find("\"name\":\"cyl\"") != std::string::npos;
         } catch (const std::exception&) {
           return false;

@@ -1,5 +1,5 @@
 // The event log's rotation as the package installs it (packaging/leakmon.logrotate), run by the
-// real logrotate against the event log the daemon writes (daemon::JsonlEventLog, the daemon's
+// real logrotate against the event log the daemon writes (pipeline::JsonlEventLog, the daemon's
 // own sink): every event lands in exactly one file, whole, the live file continues at its new
 // start after rotation (copytruncate and an append-mode file: no hole of NUL bytes), and the
 // daemon needs no signal for it.
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/event_log.hpp"
+#include "pipeline/event_log.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon {
@@ -57,7 +57,7 @@ void rotate(const std::string& dir, const std::string& log) {
 TEST(EventLogRotation, EveryEventIsKeptWholeAndTheDaemonWritesOnWithoutASignal) {
   const std::string dir = test::scratch_dir("event_log_rotation");
   const std::string log = dir + "/events.jsonl";
-  daemon::JsonlEventLog sink(log);
+  pipeline::JsonlEventLog sink(log);
   for (int n = 0; n < 3; ++n) sink.publish(numbered(n));
 
   rotate(dir, log);

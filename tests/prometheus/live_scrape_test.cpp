@@ -13,7 +13,7 @@
 #include <string>
 #include <thread>
 
-#include "daemon/http_endpoint.hpp"
+#include "http/http_endpoint.hpp"
 #include "tests/daemon/daemon_process.hpp"
 
 namespace leakmon {
@@ -82,12 +82,12 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
 
   const std::string alarm =
       "leakmon_alarm_active{actuator=\"cylinder\",alarm=\"internal_leakage\","
-      "state=\"active_unacknowledged\"}";
+      "alarm_state=\"active_unacknowledged\",state=\"active_unacknowledged\"}";
   std::string scrape;
   const bool alarmed = test::eventually(
       [&] {
         try {
-          scrape = daemon::http_request("127.0.0.1", port, "GET", "/metrics").body;
+          scrape = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
         } catch (const std::exception&) {
           return false;
         }
@@ -177,7 +177,7 @@ TEST(PrometheusLiveScrape, LearnedStateAgeCountsFromTheSavedFileAcrossARestart) 
     return test::eventually(
         [&] {
           try {
-            scrape = daemon::http_request("127.0.0.1", port, "GET", "/metrics").body;
+            scrape = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
             return scrape.find("leakmon_detector_learning{") != std::string::npos;
           } catch (const std::exception&) {
             return false;

@@ -1,5 +1,5 @@
 // libmicrohttpd 0.9.75 answering GET /metrics with a body the size of the daemon's, configured
-// as daemon/http_endpoint.cpp is (epoll, 2 threads, 512 connections, 3 s inactivity timeout),
+// as http/http_endpoint.cpp is (epoll, 2 threads, 512 connections, 3 s inactivity timeout),
 // without the endpoint's own deadline watchdog.
 #include <microhttpd.h>
 

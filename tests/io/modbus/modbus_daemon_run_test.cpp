@@ -185,7 +185,7 @@ TEST(ModbusDaemonRun, FaultsGiveGapsNotLeakAlarmsAndTheRecordingEqualsTheServedC
 // A device that updates its registers at 250 Hz, polled every 2 ms: every other sample the daemon
 // reads is the one before. That is the acquisition's fault: the daemon says so within a second
 // (driver_fault naming the actuator); that it then holds the leak decision, which such a stream
-// would otherwise turn into a false alarm, is tests/daemon/repeated_samples_test.cpp's.
+// would otherwise turn into a false alarm, is tests/pipeline/repeated_samples_test.cpp's.
 TEST(ModbusDaemonRun, ADeviceSlowerThanThePollIsReported) {
   const std::string dir = scratch_dir("ModbusDaemonRunSlowDevice");
   const std::string served = simulate_served_capture(dir, 12);

@@ -152,8 +152,9 @@ TEST(MqttBroker, DeliversEveryEventInOrderWithStatusBirthAndLastWill) {
   EXPECT_EQ(features.back().first, kTopic + "/cylinder/features");
   EXPECT_TRUE(eventually(
       [&] {
-        return subscriber.messages("/features").back().second.find("\"index\": ") !=
-               std::string::npos;
+        const std::string message = subscriber.messages("/features").back().second;
+        return message.find("\"index_p1_pa\": ") != std::string::npos &&
+               message.find("\"index\": ") != std::string::npos;  // the old name, one release
       },
       10s));
   EXPECT_EQ(metric(metrics_port, "leakmon_mqtt_queue_events{output=\"fleet\"}"), 0.0);

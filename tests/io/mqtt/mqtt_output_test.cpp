@@ -45,14 +45,14 @@ TEST(MqttOutput, DeliversEveryEventInOrderWhileOtherThreadsReadAndSample) {
   std::atomic<int> samplings{0};
   sink->attach_readings([&samplings] {
     ++samplings;
+    // The message as the daemon formats it from its snapshot (views/status_json.hpp
+    // features_json); the output only carries it.
     ActuatorReading reading;
     reading.actuator = "cyl/1";
-    reading.index = 21500.0;
-    reading.score = 0.5;
-    reading.leak_lpm_per_mpa = 0.12;
-    reading.leak_lpm_per_mpa_ci95 = 0.01;
-    reading.alarm_state = "normal";
-    reading.learning = false;
+    reading.message =
+        R"({"t": 1.5, "actuator": "cyl/1", "index_p1_pa": 21500, "score": 0.5, )"
+        R"("leak_lpm_per_mpa": 0.12, "leak_lpm_per_mpa_ci95": 0.01, "alarm_state": "normal", )"
+        R"("learning": false, "index": 21.5, "unix_time": 1800000000.5})";
     return std::vector<ActuatorReading>{reading};
   });
   constexpr int kEvents = 200;
@@ -105,6 +105,7 @@ TEST(MqttOutput, DeliversEveryEventInOrderWhileOtherThreadsReadAndSample) {
   ASSERT_TRUE(test::eventually([&] { return !subscriber.messages("/features").empty(); }, 10s));
   const auto feature = subscriber.messages("/features").back();
   EXPECT_EQ(feature.first, "leakmon/test/inproc/cyl_1/features");
+  EXPECT_NE(feature.second.find("\"index_p1_pa\": 21500, "), std::string::npos) << feature.second;
   EXPECT_NE(feature.second.find("\"index\": 21.5"), std::string::npos) << feature.second;
   EXPECT_NE(feature.second.find("\"leak_lpm_per_mpa\": 0.12"), std::string::npos);
   EXPECT_NE(feature.second.find("\"leak_lpm_per_mpa_ci95\": 0.01"), std::string::npos);
