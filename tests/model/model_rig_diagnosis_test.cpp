@@ -90,8 +90,6 @@ TEST(OtherRig, MisstatedSupplyIsARigParameterNotASensorOffset) {
   EXPECT_NEAR(params[2].value, c.misstated_true, 0.1 * c.misstated_true);
   for (const auto& cause : d.causes) EXPECT_NE(cause.effect, "sensor_offset");
   EXPECT_LT(d.nrmse_after, d.nrmse_before);
-  // The JSON's numbers carry 6 significant digits (result_json.cpp), so the stated value is
-  // compared to that precision, not for equality.
   char expected[160];
   std::snprintf(expected, sizeof expected,
                 "assert abs(c['params']['fitted']/%.9g-1)<0.1; "
