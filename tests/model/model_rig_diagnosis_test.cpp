@@ -138,5 +138,21 @@ TEST(Onset, LeakOpeningInsideTheCaptureIsNamedWithItsOnset) {
              std::string("c=r['causes'][0]; assert c['cause']=='internal_leakage'; ") + expected);
 }
 
+// A spectral line that passes its test but whose ripple fit gains nothing is never named ahead
+// of an effect that explains the data: a fixed case of `model evaluate --rigs other` (seed
+// 732024, 180 s: a 4.7e-13 leak on a 36 mm rig whose p1 + p2 shows a line at z 5.1), named
+// supply_ripple (score 0.001) first and the leak (score 0.99) second before the fix. Fixed,
+// not drawn: the case is the one the evaluation found, and its line must pass for the test
+// to mean anything (asserted).
+TEST(RippleLine, NeverNamedAheadOfAStrongerEffect) {
+  const SyntheticCase c = draw_case(732024, "internal_leakage", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_TRUE(d.ripple_line_significant) << "the case no longer has a line: pick another";
+  ASSERT_FALSE(d.causes.empty());
+  EXPECT_EQ(d.causes.front().effect, "internal_leakage") << causes(d);
+  for (const auto& cause : d.causes) EXPECT_NE(cause.effect, "supply_ripple") << causes(d);
+  EXPECT_NEAR(d.causes.front().params.front().value, c.main_value, 0.25 * c.main_value);
+}
+
 }  // namespace
 }  // namespace leakmon::model
