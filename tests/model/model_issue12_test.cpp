@@ -145,12 +145,18 @@ TEST(Drift, WarmUpWithoutTemperatureIsDriftNeverALeak) {
   CaseSettings no_temp;
   no_temp.record_temperature = false;
   int drift = 0;
-  for (const char* label : {"warm-up without temp 1", "warm-up without temp 2"}) {
+  for (const char* label :
+       {"warm-up without temp 1", "warm-up without temp 2", "warm-up without temp 3"}) {
     const Diagnosis d = run(label, "oil_temperature", no_temp);
-    // Never a constant fault that would send a crew to change seals, never "the model is right".
+    // Never a constant fault that would send a crew to change seals. "The model is right" only
+    // where the warm-up's whole misfit lies within the noise floor's band: since the floor's
+    // flow noise is drawn at 0.5 ms (issue 24) the floor is 5-10 % higher and the smallest
+    // 60 s warm-ups fall inside it (docs/model-check.md, remaining misses).
     EXPECT_NE(d.cause, "internal_leakage");
     EXPECT_FALSE(named(d, "internal_leakage"));
-    EXPECT_NE(d.cause, "none");
+    if (d.nrmse_before > DiagnosisSettings{}.floor_factor * d.nrmse_floor) {
+      EXPECT_NE(d.cause, "none");
+    }
     const bool reported = d.cause == "unexplained" && d.unexplained && d.unexplained->drifts;
     drift += reported;
     if (d.cause == "unexplained") {
@@ -159,7 +165,7 @@ TEST(Drift, WarmUpWithoutTemperatureIsDriftNeverALeak) {
       EXPECT_NE(json.find("\"drifts\": true"), std::string::npos);
     }
   }
-  EXPECT_GE(drift, 1) << "drift reported in fewer than one of two warm-ups";
+  EXPECT_GE(drift, 1) << "drift reported in none of three warm-ups";
 }
 
 TEST(HonestNone, CleanDataReachesTheFloorAndIsNone) {
