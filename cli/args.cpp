@@ -53,7 +53,7 @@ bool ArgParser::parse(int argc, char** argv, int first) {
       if (!spec) throw UsageError(fmt::format("unknown option '--{}'", body));
       if (spec->is_flag) {
         if (inline_value) throw UsageError(fmt::format("option '--{}' takes no value", body));
-        values_[spec->name] = "1";
+        values_[spec->name] = std::string("1");  // not = "1": GCC 12 -O3's -Wrestrict
         continue;
       }
       if (inline_value) {

@@ -250,7 +250,10 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
 }
 
 bool has_learned(const DetectorState& state) {
-  for (const auto& [key, values] : state.entries()) {
+  for (const auto& entry : state.entries()) {
+    // Not a structured binding: Clang before 16 cannot capture one in a lambda.
+    const std::string& key = entry.first;
+    const std::vector<double>& values = entry.second;
     if (values.size() != 1) continue;
     const auto named = [&key](std::string_view name) {
       return key == name || (key.size() > name.size() && key.ends_with(name) &&

@@ -448,11 +448,13 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     }
     std::stable_sort(screened_joint.begin(), screened_joint.end());
     std::vector<std::size_t> next;
-    for (const auto& [cost, i] : screened_joint) {
+    for (const auto& ranked : screened_joint) {
+      // Not a structured binding: Clang before 16 cannot capture one in a lambda.
+      const std::size_t candidate = ranked.second;
       const bool seen = std::any_of(next.begin(), next.end(), [&](std::size_t j) {
-        return library[j].effect == library[i].effect;
+        return library[j].effect == library[candidate].effect;
       });
-      if (!seen && next.size() < settings.step_candidates) next.push_back(i);
+      if (!seen && next.size() < settings.step_candidates) next.push_back(candidate);
     }
     std::optional<SelectionStep> best_step;
     EffectCandidate best_joint;

@@ -7,7 +7,6 @@ namespace leakmon::sim {
 
 FlowNoise::FlowNoise(double sigma, double tau, double grid_step_s, std::uint64_t seed)
     : sigma_(sigma),
-      tau_(tau),
       grid_step_(grid_step_s),
       decay_(std::exp(-grid_step_s / tau)),
       innovation_(sigma * std::sqrt(1.0 - decay_ * decay_)),

@@ -26,7 +26,7 @@ class FlowNoise {
  private:
   void draw_next() noexcept;
 
-  double sigma_, tau_, grid_step_, decay_, innovation_;
+  double sigma_, grid_step_, decay_, innovation_;  // tau enters through decay_
   std::uint64_t seed_;
   Random random_;
   std::int64_t cell_ = 0;  // w_lo_ is w at cell_ * grid_step_, w_hi_ at the next grid point

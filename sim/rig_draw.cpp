@@ -22,7 +22,6 @@ double log_uniform(Random& random, double lo, double hi) {
 // The stream the drawer takes its numbers from, apart from the simulation's own streams.
 constexpr std::uint64_t kRigStream = 0x7269672d64726177ULL;  // "rig-draw"
 constexpr int kMaxAttempts = 500;
-constexpr double kMinAmplitude = 5e-3;
 
 RigDescription draw_description(Random& random) {
   RigDescription rig;
