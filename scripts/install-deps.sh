@@ -17,7 +17,7 @@ build=(
   dpkg-dev file help2man
 )
 test=(
-  clang clang-format libclang-rt-14-dev
+  clang clang-format libclang-rt-14-dev lld
   libgtest-dev libgmock-dev libbenchmark-dev
   mosquitto mosquitto-clients prometheus
   python3 python3-numpy python3-pywt python3-matplotlib python3-pymodbus python3-serial
