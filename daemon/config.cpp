@@ -140,7 +140,8 @@ void convert_leak_sizes(const config::ConfigNode& options) {
 }
 
 pipeline::AlarmSettings parse_alarm(const config::ConfigNode& node) {
-  node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching"});
+  node.expect_keys({"name", "raise", "clear", "on_delay_s", "off_delay_s", "latching",
+                    "not_judged_event_seconds"});
   pipeline::AlarmSettings alarm{NAN, NAN, 0.0, 0.0, false};
   if (node.has("raise")) alarm.raise_threshold = node.get_double("raise", -1e9, 1e9);
   if (node.has("clear")) alarm.clear_threshold = node.get_double("clear", -1e9, 1e9);
@@ -154,6 +155,8 @@ pipeline::AlarmSettings parse_alarm(const config::ConfigNode& node) {
   alarm.on_delay_s = node.get_double("on_delay_s", 0.0, 0.0, 86400.0);
   alarm.off_delay_s = node.get_double("off_delay_s", 0.0, 0.0, 86400.0);
   alarm.latching = node.get_bool("latching", false);
+  alarm.not_judged_event_seconds =
+      node.get_double("not_judged_event_seconds", alarm.not_judged_event_seconds, 0.0, 1e7);
   return alarm;
 }
 

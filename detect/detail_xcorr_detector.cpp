@@ -197,6 +197,7 @@ Decision DetailXcorrDetector::update(const Observation& observation) {
   decision.score = verdict.score;
   // For the operator: the paper's index of the chamber, not the feature's scale.
   decision.index = use_p2_alone_ ? observation.index_p2 : observation.index_p1;
+  decision.judge_by_score();
   return decision;
 }
 

@@ -3,6 +3,7 @@
 // score that the alarm state machine (daemon/) compares with its raise/clear thresholds.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -38,6 +39,40 @@ struct Observation {
   std::span<const double> p1_samples, p2_samples;
 };
 
+// Why a detector is not judging: it cannot see a leak right now, whatever the score says (the
+// score holds). Unlike detection_blind (the rig, permanently), these pass when the operation or
+// the data changes.
+enum class NotJudgedReason {
+  none,                    // judging
+  learning,                // learning the healthy baseline
+  waiting_for_excitation,  // learning is over but the data has too few distinct loads at rest
+  cannot_learn,            // waited max_excitation_wait_seconds for them in vain: nothing learned
+  in_motion,               // no block at rest lately (sine, sweep, triangle)
+  no_load,                 // at rest near |p1 - p2| = 0: a leak's flow C_L (p1 - p2) vanishes
+  outside_learned_loads,   // at rest at a load the learning data never covered
+  supply_settling,         // the supply pressure is still moving after a step
+  no_excitation,           // pressure-only: the index is far below its learned level (a hold)
+  data_gap,                // the observations lack a signal the detector needs
+  sensor_fault,            // a channel is faulty or suspect: the detector is not fed
+};
+
+// The names the daemon uses for the reasons (/status, metrics labels, events), in enum order.
+inline constexpr std::array<std::string_view, 11> kNotJudgedReasonNames = {"none",
+                                                                           "learning",
+                                                                           "waiting_for_excitation",
+                                                                           "cannot_learn",
+                                                                           "in_motion",
+                                                                           "no_load",
+                                                                           "outside_learned_loads",
+                                                                           "supply_settling",
+                                                                           "no_excitation",
+                                                                           "data_gap",
+                                                                           "sensor_fault"};
+
+constexpr std::string_view to_string(NotJudgedReason reason) {
+  return kNotJudgedReasonNames[static_cast<std::size_t>(reason)];
+}
+
 struct Decision {
   // Dimensionless evidence of a leak: the alarm raises when score >= raise_threshold() and
   // clears when score <= clear_threshold(). NaN when the detector cannot judge this hop (still
@@ -56,6 +91,17 @@ struct Decision {
   // nu(40 degC) / nu(T) at the oil temperature of this hop when the detector knows it (the
   // leak coefficient is then stated at 40 degC and flows r C_L (p1 - p2) now); NaN otherwise.
   double viscosity_ratio = kMissing;
+  // Whether this decision could have revealed a leak, and why not (none when judged). A
+  // detector that does not say otherwise judges whenever it has learned and has a score.
+  bool judged = false;
+  NotJudgedReason not_judged_reason = NotJudgedReason::learning;
+  // Sets judged / not_judged_reason from `learning` and the score, for detectors without more
+  // to say.
+  void judge_by_score() {
+    judged = !learning && !std::isnan(score);
+    not_judged_reason = judged ? NotJudgedReason::none
+                               : (learning ? NotJudgedReason::learning : NotJudgedReason::data_gap);
+  }
 };
 
 class Detector {

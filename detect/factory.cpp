@@ -183,7 +183,11 @@ std::vector<Option<IndexCusumOptions>> index_rows() {
                               [](O& o) -> double& { return o.temperature_prior; }),
              number_option<O>("temperature_prior_sigma", 1e-4, 10.0,
                               "uncertainty of temperature_prior",
-                              [](O& o) -> double& { return o.temperature_prior_sigma; })} +
+                              [](O& o) -> double& { return o.temperature_prior_sigma; }),
+             number_option<O>("no_excitation_share", 0.0, 1.0,
+                              "below this share of its learned level the index is not judged "
+                              "(no_excitation: a hold)",
+                              [](O& o) -> double& { return o.no_excitation_share; })} +
          drift_options<O>(0.0) + supply_settle_options<O>() + oil_options<O>();
 }
 
@@ -274,6 +278,35 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
                }
              },
              0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
+         std::vector<Option<O>>{
+             number_option<O>("min_rest_loads", 1.0, 100.0,
+                              "learning needs blocks at rest at this many distinct loads",
+                              [](O& o) -> double& { return o.min_rest_loads; }),
+             number_option<O>("rest_load_tolerance", 1e3, 1e8,
+                              "rest loads |p1 - p2| further apart than this are distinct [Pa]",
+                              [](O& o) -> double& { return o.rest_load_tolerance; }),
+             number_option<O>("max_excitation_wait_seconds", 0.0, kMaxOptionSeconds,
+                              "how long learning starts over for want of distinct rest loads "
+                              "before it says it cannot learn [s]",
+                              [](O& o) -> double& { return o.max_excitation_wait_seconds; }),
+             other_option<O>(
+                 "limit_to_learned", "", "true, false",
+                 "judge only blocks at rest within the learned rest loads (+- "
+                 "rest_load_tolerance)",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr) {
+                     o.limit_to_learned = node->get_bool(row.key, o.limit_to_learned);
+                   }
+                 },
+                 0.0, 0.0, [](O& o) { return std::string(o.limit_to_learned ? "true" : "false"); }),
+             number_option<O>("no_load_pressure", 0.0, 1e8,
+                              "below this |p1 - p2| a block at rest is not judged (no_load) "
+                              "[Pa]",
+                              [](O& o) -> double& { return o.no_load_pressure; }),
+             number_option<O>("judged_memory_seconds", 0.0, kMaxOptionSeconds,
+                              "a decision is judged while a block was judged at most this long "
+                              "ago [s]",
+                              [](O& o) -> double& { return o.judged_memory_seconds; })} +
          oil_options<O>();
 }
 

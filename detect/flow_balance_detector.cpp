@@ -68,8 +68,13 @@ void FlowBalanceDetector::reset() {
   coefficients_.setZero();
   positive_loads_ = negative_loads_ = LoadRange{};
   block_sigma_ = hop_sigma_ = kMissing;
-  block_hop_ = block_rest_hops_ = 0;
-  block_residual_sum_ = block_leak_term_sum_ = 0.0;
+  block_hop_ = block_rest_hops_ = block_unsettled_hops_ = 0;
+  block_residual_sum_ = block_leak_term_sum_ = block_load_sum_ = 0.0;
+  rest_load_low_ = rest_load_high_ = kMissing;
+  excitation_wait_hops_ = 0;
+  cannot_learn_ = false;
+  last_judged_t_ = kMissing;
+  block_reason_ = NotJudgedReason::in_motion;
   weighted_ = since_change_ = change_block_ = SlopeSums{};
   cusum_.reset();
   supply_.reset();
@@ -140,6 +145,52 @@ double FlowBalanceDetector::robust_hop_sigma() {
 bool FlowBalanceDetector::on_flow_branch(const Hop& hop) const {
   const double short_of_healthy = (expected_opening(hop) - hop.opening) * sign_of(hop.load);
   return !(short_of_healthy > kOffBranchSigmas * hop_sigma_);
+}
+
+bool FlowBalanceDetector::excited_enough() {
+  // Loads of the blocks at rest (blocks grouped as in detection), in units of ps.
+  scratch_.clear();
+  for (std::size_t i = 0; i < learned_.size();) {
+    std::size_t j = i;
+    double load_sum = 0.0;
+    for (; j < learned_.size() && learned_[j].block == learned_[i].block; ++j) {
+      load_sum += learned_[j].load;
+    }
+    if (j - i >= min_rest_hops_) scratch_.push_back(load_sum / static_cast<double>(j - i));
+    i = j;
+  }
+  if (scratch_.empty()) return false;
+  std::sort(scratch_.begin(), scratch_.end());
+  // Distinct: further from the lowest load of the current group than the tolerance.
+  const double tolerance = options_.rest_load_tolerance / options_.rig.ps;
+  double group_start = scratch_.front();
+  std::size_t distinct = 1;
+  for (const double load : scratch_) {
+    if (load - group_start > tolerance) {
+      group_start = load;
+      ++distinct;
+    }
+  }
+  if (static_cast<double>(distinct) < options_.min_rest_loads) return false;
+  rest_load_low_ = scratch_.front();
+  rest_load_high_ = scratch_.back();
+  return true;
+}
+
+void FlowBalanceDetector::set_judged(Decision& decision, double t) const {
+  if (decision.learning) {
+    decision.judged = false;
+    decision.not_judged_reason = excitation_wait_hops_ > 0 ? NotJudgedReason::waiting_for_excitation
+                                                           : NotJudgedReason::learning;
+    return;
+  }
+  if (cannot_learn_ || std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) {
+    decision.judged = false;
+    decision.not_judged_reason = NotJudgedReason::cannot_learn;
+    return;
+  }
+  decision.judged = t - last_judged_t_ <= options_.judged_memory_seconds;  // false when NaN
+  decision.not_judged_reason = decision.judged ? NotJudgedReason::none : block_reason_;
 }
 
 void FlowBalanceDetector::finish_learning() {
@@ -244,6 +295,7 @@ Decision FlowBalanceDetector::update(const Observation& o) {
   if (!std::isnan(o.temp)) temperature_seen_ = true;
   const bool temperature_ok = !temperature_seen_ || !std::isnan(o.temp);
   const bool supply_settled = supply_.settled(o.t);
+  if (!supply_settled && clock_.learned()) ++block_unsettled_hops_;
   hop.usable = !std::isnan(o.u) && !std::isnan(o.p1) && !std::isnan(o.p2) &&
                !std::isnan(hop.speed) && temperature_ok && supply_settled &&
                std::abs(o.u) < 0.5 * options_.rig.u_max;
@@ -286,28 +338,65 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
   }
   if (!clock_.learned()) {
     if (at_rest) learned_.push_back({hop, clock_.learning_hop() / block_hops_});
-    if (clock_.period_over()) finish_learning();
+    if (clock_.period_over()) {
+      const std::size_t max_wait_hops = static_cast<std::size_t>(
+          std::lround(options_.max_excitation_wait_seconds / hop_seconds_));
+      if (excited_enough()) {
+        finish_learning();
+        block_reason_ = NotJudgedReason::in_motion;
+      } else if (excitation_wait_hops_ >= max_wait_hops) {
+        // Learning from these data would extrapolate the healthy command from one load.
+        cannot_learn_ = true;
+        learned_.clear();
+        clock_.set_learned();
+      } else {
+        excitation_wait_hops_ += clock_.learn_hops();
+        learned_.clear();
+        clock_.restart_period();
+      }
+    }
+    if (!clock_.learned()) decision.learning_hops_left = clock_.hops_left();
+    set_judged(decision, hop.t);
     last_ = decision;
     return;
   }
   decision.learning = false;
-  if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) {
+  if (cannot_learn_ || std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) {
+    set_judged(decision, hop.t);
     last_ = decision;
     return;
   }
   if (at_rest && on_flow_branch(hop)) {
     block_residual_sum_ += hop.opening - expected_opening(hop);
     block_leak_term_sum_ += hop.leak_term;
+    block_load_sum_ += hop.load;
     ++block_rest_hops_;
   }
   if (++block_hop_ >= block_hops_) {
     if (block_rest_hops_ >= min_rest_hops_) {
       const double n = static_cast<double>(block_rest_hops_);
-      judge_block(hop.t, block_residual_sum_ / n, block_leak_term_sum_ / n);
+      const double load = block_load_sum_ / n;
+      const double margin = options_.rest_load_tolerance / options_.rig.ps;
+      // NaN bounds (an older state) compare false: no limit.
+      if (options_.limit_to_learned &&
+          (load < rest_load_low_ - margin || load > rest_load_high_ + margin)) {
+        block_reason_ = NotJudgedReason::outside_learned_loads;
+      } else {
+        judge_block(hop.t, block_residual_sum_ / n, block_leak_term_sum_ / n);
+        if (std::abs(load) * options_.rig.ps < options_.no_load_pressure) {
+          block_reason_ = NotJudgedReason::no_load;
+        } else {
+          last_judged_t_ = hop.t;
+        }
+      }
+    } else {
+      block_reason_ =
+          block_unsettled_hops_ > 0 ? NotJudgedReason::supply_settling : NotJudgedReason::in_motion;
     }
-    block_hop_ = block_rest_hops_ = 0;
-    block_residual_sum_ = block_leak_term_sum_ = 0.0;
+    block_hop_ = block_rest_hops_ = block_unsettled_hops_ = 0;
+    block_residual_sum_ = block_leak_term_sum_ = block_load_sum_ = 0.0;
   }
+  set_judged(decision, hop.t);
   decision.score = cusum_.normalised();
   decision.viscosity_ratio = hop.viscosity_ratio;
   const SlopeSums& sums = cusum_.value() <= 0.0    ? weighted_
@@ -369,6 +458,14 @@ DetectorState FlowBalanceDetector::export_state() const {
   state.put_count("block.rest_hops", block_rest_hops_);
   state.put("block.residual_sum", block_residual_sum_);
   state.put("block.leak_term_sum", block_leak_term_sum_);
+  state.put("block.load_sum", block_load_sum_);
+  state.put_count("block.unsettled_hops", block_unsettled_hops_);
+  state.put("rest_loads.low", rest_load_low_);
+  state.put("rest_loads.high", rest_load_high_);
+  state.put_count("excitation.wait_hops", excitation_wait_hops_);
+  state.put("excitation.cannot_learn", cannot_learn_ ? 1.0 : 0.0);
+  state.put("judging.last_judged_t", last_judged_t_);
+  state.put("judging.reason", static_cast<double>(block_reason_));
   for (const auto& [key, sums] :
        {std::pair{"sizing.weighted", &weighted_}, std::pair{"sizing.since_change", &since_change_},
         std::pair{"sizing.change_block", &change_block_}}) {
@@ -422,6 +519,18 @@ void FlowBalanceDetector::import_state(const DetectorState& saved) {
     }
     block_residual_sum_ = state.get("block.residual_sum");
     block_leak_term_sum_ = state.get("block.leak_term_sum");
+    block_load_sum_ = state.get("block.load_sum");
+    block_unsettled_hops_ = state.get_count("block.unsettled_hops");
+    rest_load_low_ = state.get("rest_loads.low");
+    rest_load_high_ = state.get("rest_loads.high");
+    excitation_wait_hops_ = state.get_count("excitation.wait_hops");
+    cannot_learn_ = state.get("excitation.cannot_learn") != 0.0;
+    last_judged_t_ = state.get("judging.last_judged_t");
+    const double reason = state.get("judging.reason");
+    if (!(reason >= 0.0 && reason < static_cast<double>(kNotJudgedReasonNames.size()))) {
+      throw StateError("judging.reason out of range");
+    }
+    block_reason_ = static_cast<NotJudgedReason>(static_cast<int>(reason));
     for (const auto& [key, sums] : {std::pair{"sizing.weighted", &weighted_},
                                     std::pair{"sizing.since_change", &since_change_},
                                     std::pair{"sizing.change_block", &change_block_}}) {
@@ -446,6 +555,7 @@ void FlowBalanceDetector::import_state(const DetectorState& saved) {
 // gap are not neighbours of the next ones.
 void FlowBalanceDetector::resume_after_gap() {
   drift_.clear();
+  last_judged_t_ = kMissing;  // on the old source clock
   supply_.resume_after_gap();
   previous_x_ = kMissing;
   before_ = pending_ = Hop{};

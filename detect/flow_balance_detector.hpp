@@ -69,6 +69,23 @@ struct FlowBalanceOptions {
   double drift_window_seconds = 120.0;
   // Supply from the chamber pressures at rest when there is no `ps` observation.
   bool estimate_supply = true;
+  // Excitation (MODEL.md "Test programs"). The healthy command is fitted against the load, so
+  // learning needs blocks at rest at `min_rest_loads` loads |p1 - p2| further apart than
+  // `rest_load_tolerance` [Pa]: a hold gives one load, from which the fit extrapolates wildly.
+  // A learning period without them starts over, for at most `max_excitation_wait_seconds`
+  // after the first; then the detector says it cannot learn rather than learn a wrong model.
+  double min_rest_loads = 3.0;
+  double rest_load_tolerance = 0.3e6;
+  double max_excitation_wait_seconds = 1800.0;
+  // Judge only blocks at rest whose load lies within the learned rest loads (widened by
+  // rest_load_tolerance); others are not judged (outside_learned_loads).
+  bool limit_to_learned = true;
+  // Below this |p1 - p2| [Pa] a leak hardly flows: blocks there are not counted as judged
+  // (no_load), though the test still takes them.
+  double no_load_pressure = 1e6;
+  // A decision is judged while a block was judged at most this long ago [s]: a steps program
+  // moves between its holds without the detector going blind.
+  double judged_memory_seconds = 10.0;
 };
 
 class FlowBalanceDetector final : public Detector {
@@ -88,7 +105,7 @@ class FlowBalanceDetector final : public Detector {
   void resume_after_gap() override;
 
   // The layout export_state() writes (legacy_state.hpp reads the ones before).
-  static constexpr int kStateVersion = 3;
+  static constexpr int kStateVersion = 4;
 
  private:
   struct Hop {
@@ -141,6 +158,11 @@ class FlowBalanceDetector final : public Detector {
   static constexpr double kMinRoot = 1e-3;  // a chamber at supply or tank: no flow to judge
   void accept(const Hop& hop, bool at_rest);
   void finish_learning();
+  // At the end of a learning period: whether its blocks at rest cover min_rest_loads distinct
+  // loads; sets rest_load_low_ / rest_load_high_ from them. Uses scratch_.
+  bool excited_enough();
+  // The decision's judged state at source time t.
+  void set_judged(Decision& decision, double t) const;
   void judge_block(double t, double mean_residual, double mean_leak_term);
   double supply_for(const Observation& o, double speed);
   // Drift following (the healthy slope as a reference) only without a temperature.
@@ -165,7 +187,18 @@ class FlowBalanceDetector final : public Detector {
   double block_sigma_ = kMissing;
   // The current block.
   std::size_t block_hop_ = 0, block_rest_hops_ = 0;
-  double block_residual_sum_ = 0.0, block_leak_term_sum_ = 0.0;
+  double block_residual_sum_ = 0.0, block_leak_term_sum_ = 0.0, block_load_sum_ = 0.0;
+  // Hops of the current block the supply was still settling in (names why it was not judged).
+  std::size_t block_unsettled_hops_ = 0;
+  // Learned rest block loads [of ps], the range limit_to_learned judges within; NaN: no limit
+  // (a state saved before they were learned).
+  double rest_load_low_ = kMissing, rest_load_high_ = kMissing;
+  // Hops of learning periods that started over for want of excitation; whether the wait ran out.
+  std::size_t excitation_wait_hops_ = 0;
+  bool cannot_learn_ = false;
+  // Source time of the newest judged block, and why the newest unjudged one was not.
+  double last_judged_t_ = kMissing;
+  NotJudgedReason block_reason_ = NotJudgedReason::in_motion;
   // The added slope by least squares of residual on leak term. While the CUSUM is positive, over
   // the blocks since it last left zero (its estimate of the change time), so that the size in
   // an alarm is not diluted by healthy data; otherwise exponentially weighted.

@@ -20,6 +20,7 @@ void FusedDetector::reset() {
 Decision FusedDetector::update(const Observation& observation) {
   Decision fused;
   fused.learning = false;
+  fused.not_judged_reason = NotJudgedReason::none;
   for (std::size_t i = 0; i < members_.size(); ++i) {
     const Decision d = members_[i]->update(observation);
     member_decisions_[i] = d;
@@ -31,6 +32,11 @@ Decision FusedDetector::update(const Observation& observation) {
       const double relative = d.score / members_[i]->raise_threshold();
       if (std::isnan(fused.score) || relative > fused.score) fused.score = relative;
     }
+    // Judged when a member judges; otherwise the first member's reason (the flow balance's).
+    fused.judged = fused.judged || d.judged;
+    if (!d.judged && fused.not_judged_reason == NotJudgedReason::none) {
+      fused.not_judged_reason = d.not_judged_reason;
+    }
     if (std::isnan(fused.index) && !std::isnan(d.index)) {
       fused.index = d.index;
       fused.baseline = d.baseline;
@@ -41,6 +47,7 @@ Decision FusedDetector::update(const Observation& observation) {
       fused.viscosity_ratio = d.viscosity_ratio;
     }
   }
+  if (fused.judged) fused.not_judged_reason = NotJudgedReason::none;
   return fused;
 }
 

@@ -30,6 +30,7 @@ FeaturePhysics index_physics(const IndexCusumOptions& o) {
 IndexCusumDetector::IndexCusumDetector(const IndexCusumOptions& options, double hop_seconds)
     : use_p1_(options.use_p1),
       use_p2_(options.use_p2),
+      no_excitation_share_(options.no_excitation_share),
       test_(options, index_physics(options), hop_seconds) {}
 
 // The mean log index of the configured chambers; NaN when one of them has a gap.
@@ -55,6 +56,11 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   decision.learning_hops_left = verdict.learning_hops_left;
   decision.score = verdict.score;
   decision.baseline = std::isnan(verdict.expected) ? kMissing : std::exp(verdict.expected);
+  decision.judge_by_score();
+  if (decision.judged && decision.index < no_excitation_share_ * decision.baseline) {
+    decision.judged = false;
+    decision.not_judged_reason = NotJudgedReason::no_excitation;
+  }
   return decision;
 }
 

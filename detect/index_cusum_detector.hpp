@@ -35,6 +35,10 @@ struct IndexCusumOptions : FeatureTestOptions {
   double temperature_prior = 0.2;
   double temperature_prior_sigma = 0.05;
   sim::Oil oil = sim::Oil::standard();
+  // An index below this share of its learned level is no leak (one of interest drops it by
+  // design_drop) but a rig without the excitation that makes the hydraulic mode ring, such as a
+  // hold: such decisions are not judged (no_excitation).
+  double no_excitation_share = 0.5;
 };
 
 class IndexCusumDetector final : public Detector {
@@ -59,6 +63,7 @@ class IndexCusumDetector final : public Detector {
   double log_index_of(const Observation& observation) const;
 
   bool use_p1_, use_p2_;
+  double no_excitation_share_;
   FeatureTest test_;
 };
 

@@ -57,6 +57,8 @@ class LearningClock {
 
   bool learned() const { return learned_; }
   void set_learned() { learned_ = true; }
+  // The learning period starts over with the next hop (its data did not suffice; no settling).
+  void restart_period() { hops_seen_ = settle_hops_; }
   void reset() {
     hops_seen_ = 0;
     learned_ = false;

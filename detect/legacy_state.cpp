@@ -120,6 +120,22 @@ DetectorState flow_from_2(const DetectorState& old) {
   return c.out();
 }
 
+// flow_balance 3 -> 4: the excitation and judging entries. No learned rest loads: the state
+// judges at every load, as the build that wrote it did.
+DetectorState flow_from_3(const DetectorState& old) {
+  DetectorState out(old.kind(), 4);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  out.put("block.load_sum", 0.0);
+  out.put_count("block.unsettled_hops", 0);
+  out.put("rest_loads.low", kNaN);
+  out.put("rest_loads.high", kNaN);
+  out.put_count("excitation.wait_hops", 0);
+  out.put("excitation.cannot_learn", 0.0);
+  out.put("judging.last_judged_t", kNaN);
+  out.put("judging.reason", static_cast<double>(NotJudgedReason::in_motion));
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -241,6 +257,10 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
   if (state.kind() == kind && state.version() == version) return state;
   if (state.kind() == kind) {
     if (kind == "flow_balance" && state.version() == 2 && version == 3) return flow_from_2(state);
+    if (kind == "flow_balance" && state.version() == 2 && version == 4) {
+      return flow_from_3(flow_from_2(state));
+    }
+    if (kind == "flow_balance" && state.version() == 3 && version == 4) return flow_from_3(state);
     if (kind == "index_cusum" && state.version() == 3 && version == 4) return index_from_3(state);
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
     if (kind == "detail_xcorr" && state.version() == 1 && version == 2) return xcorr_from_1(state);

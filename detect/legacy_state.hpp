@@ -2,7 +2,7 @@
 // so that a daemon updated in place resumes from its state files instead of relearning. The
 // layouts read (each detector's version before its pieces saved themselves under names,
 // issue 26):
-//   flow_balance 2, index_cusum 3, paper 1, detail_xcorr 1 (its test an index_cusum 3);
+//   flow_balance 2 and 3, index_cusum 3, paper 1, detail_xcorr 1 (its test an index_cusum 3);
 //   fused 1 is unchanged (its members' states carry their own layouts).
 // The conversion renames and splits lists; it computes nothing, so a converted state decides
 // exactly as the old build would have.

@@ -26,13 +26,20 @@ void PaperBaselineDetector::reset() {
   below_count_ = 0;
 }
 
+namespace {
+Decision judged(Decision decision) {
+  decision.judge_by_score();
+  return decision;
+}
+}  // namespace
+
 Decision PaperBaselineDetector::update(const Observation& observation) {
   const double index = options_.use_p2 ? observation.index_p2 : observation.index_p1;
   Decision decision;
   decision.index = index;
   const bool past_settling = clock_.count_hop();
   if (!clock_.learned()) decision.learning_hops_left = clock_.hops_left();
-  if (!past_settling) return decision;
+  if (!past_settling) return judged(decision);
 
   if (!clock_.learned()) {
     if (!std::isnan(index)) learned_.push_back(index);  // capacity reserved: never reallocates
@@ -44,12 +51,12 @@ Decision PaperBaselineDetector::update(const Observation& observation) {
       baseline_ = *nth;
       clock_.set_learned();
     }
-    return decision;
+    return judged(decision);
   }
 
   decision.learning = false;
   decision.baseline = baseline_;
-  if (std::isnan(index)) return decision;
+  if (std::isnan(index)) return judged(decision);
   const bool below = index < baseline_;
   if (window_.full() && window_.oldest().below) --below_count_;
   window_.push({below});
@@ -57,7 +64,7 @@ Decision PaperBaselineDetector::update(const Observation& observation) {
   if (window_.full()) {
     decision.score = static_cast<double>(below_count_) / static_cast<double>(window_.capacity());
   }
-  return decision;
+  return judged(decision);
 }
 
 DetectorState PaperBaselineDetector::export_state() const {

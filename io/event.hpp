@@ -40,6 +40,11 @@ enum class EventKind {
   // the transducers' noise while it learns (pipeline/mode_visibility.hpp), so no leak alarm can
   // come from it. Announced when learning ends and again after a restart.
   detection_blind,
+  // The detector has not been judging for longer than the alarm's not_judged_event_seconds
+  // (`reason` says why, `not_judged_since` from when): a leak opening now would go unseen. And
+  // the end of that.
+  not_judged,
+  judging_resumed,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -74,6 +79,10 @@ constexpr std::string_view to_string(EventKind kind) {
       return "relearning";
     case EventKind::detection_blind:
       return "detection_blind";
+    case EventKind::not_judged:
+      return "not_judged";
+    case EventKind::judging_resumed:
+      return "judging_resumed";
   }
   return "unknown";
 }
@@ -116,6 +125,8 @@ struct Event {
   // from when the detector decides again (learning done).
   double learning_since = kNoValue;
   double protected_from = kNoValue;
+  // not_judged / judging_resumed: source time [s] the detector stopped judging.
+  double not_judged_since = kNoValue;
 };
 
 // One actuator's newest decision as an output may publish it: its feature message, one JSON

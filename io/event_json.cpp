@@ -120,6 +120,7 @@ std::string to_json_line(const Event& event) {
   json.number("uptime_s", event.uptime_s);
   json.number("learning_since", event.learning_since);
   json.number("protected_from", event.protected_from);
+  json.number("not_judged_since", event.not_judged_since);
   json.string("message", event.message);
   if (std::isfinite(event.unix_time)) {
     const auto seconds = static_cast<std::time_t>(event.unix_time);

@@ -36,6 +36,9 @@ std::unique_ptr<detect::Detector> build_detector(const ActuatorConfig& config,
 // Learning hops the mode verdict needs at least (1 s at the default hop of 40 ms); with fewer the
 // rig stays unjudged.
 constexpr std::size_t kModeJudgedHops = 25;
+// A pressure-only detector's index below this share of the learning period's median reads no
+// hydraulic mode (a hold); a leak of interest lowers it by a few percent, the largest by a third.
+constexpr double kNoExcitationShare = 0.5;
 
 // The mode of a rig that `rig:` describes; NaN for the paper's (nothing stated).
 double rig_mode_hz(const sim::RigDescription& rig) {
@@ -361,6 +364,7 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   // A faulty or suspect channel: neither decide nor learn; the score and the alarm hold.
   if (fed_ < blocked_until_) {
     ++suspended_decisions_;
+    track_judging(t, false, detect::NotJudgedReason::sensor_fault, publish);
     return;
   }
   const bool was_learning = last_decision_.learning;
@@ -369,10 +373,63 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
   if (watch_mode_) judge_mode_visibility(t, observation, publish);
+  // A pressure-only detector sees a leak through the hydraulic mode, which a hold leaves
+  // unexcited: an index far below the learning period's median is not a reading of it.
+  bool judged = last_decision_.judged;
+  detect::NotJudgedReason reason = last_decision_.not_judged_reason;
+  if (judged && watch_mode_ && std::isfinite(healthy_index_ratio_)) {
+    const double learned_index = healthy_index_ratio_ * mode_checks_[0].noise_floor();
+    const double index = std::max(std::isnan(observation.index_p1) ? 0.0 : observation.index_p1,
+                                  std::isnan(observation.index_p2) ? 0.0 : observation.index_p2);
+    if (index < kNoExcitationShare * learned_index) {
+      judged = false;
+      reason = detect::NotJudgedReason::no_excitation;
+    }
+  }
+  track_judging(t, judged, reason, publish);
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
   if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));
   if (transition.cleared) publish(alarm_event(io::EventKind::alarm_cleared, t));
+}
+
+void ActuatorMonitor::track_judging(double t, bool judged, detect::NotJudgedReason reason,
+                                    const EventPublisher& publish) {
+  const double hop_seconds = static_cast<double>(config_.features.step) / sample_rate_hz_;
+  decided_seconds_ += hop_seconds;
+  if (judged) judged_seconds_ += hop_seconds;
+  if (judged && !judged_ && not_judged_announced_) {
+    io::Event event;
+    event.kind = io::EventKind::judging_resumed;
+    event.t = t;
+    event.actuator = config_.name;
+    event.alarm = config_.alarm_name;
+    event.not_judged_since = not_judged_since_;
+    event.message = fmt::format("{}: the {} detector judges again after {:.0f} s", config_.name,
+                                detector_->name(), t - not_judged_since_);
+    publish(event);
+    not_judged_announced_ = false;
+  }
+  if (!judged && (judged_ || std::isnan(not_judged_since_))) not_judged_since_ = t;
+  if (judged) not_judged_since_ = kNaN;
+  judged_ = judged;
+  not_judged_reason_ = judged ? detect::NotJudgedReason::none : reason;
+  if (!judged && !not_judged_announced_ &&
+      t - not_judged_since_ >= config_.alarm.not_judged_event_seconds) {
+    io::Event event;
+    event.kind = io::EventKind::not_judged;
+    event.t = t;
+    event.actuator = config_.name;
+    event.alarm = config_.alarm_name;
+    event.reason = std::string(detect::to_string(not_judged_reason_));
+    event.not_judged_since = not_judged_since_;
+    event.message = fmt::format(
+        "{}: the {} detector has not judged for {:.0f} s ({}): a leak opening now would not "
+        "raise {}",
+        config_.name, detector_->name(), t - not_judged_since_, event.reason, config_.alarm_name);
+    publish(event);
+    not_judged_announced_ = true;
+  }
 }
 
 void ActuatorMonitor::acknowledge(const EventPublisher& publish) {
@@ -479,6 +536,11 @@ void ActuatorMonitor::status_into(ActuatorStatus& status) const {
   status.detection_blind = detection_blind();
   status.suspended_decisions = suspended_decisions_;
   status.relearns = relearns_;
+  status.judged = judged_;
+  status.not_judged_reason = not_judged_reason_;
+  status.not_judged_since = not_judged_since_;
+  status.judged_seconds = judged_seconds_;
+  status.decided_seconds = decided_seconds_;
   // The detector counts its own hops (it does not learn while a faulty channel suspends it);
   // before its first decision, and after a reload made it learn again, the protection end
   // the monitor set is what is known.

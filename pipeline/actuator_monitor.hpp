@@ -90,6 +90,14 @@ struct ActuatorStatus {
   bool suspended = false;                 // the detector is not fed: a channel is faulty or suspect
   std::uint64_t suspended_decisions = 0;  // hops not given to the detector for that reason
   std::uint64_t relearns = 0;             // how often a reload made the detector learn again
+  // Whether the newest decision could have revealed a leak; why not; the source time it
+  // stopped judging (NaN while judging); the source seconds of decisions (hops the detector
+  // was given or held back from) and of those judged, since the monitor started.
+  bool judged = false;
+  detect::NotJudgedReason not_judged_reason = detect::NotJudgedReason::learning;
+  double not_judged_since = io::kNoValue;
+  double judged_seconds = 0.0;
+  double decided_seconds = 0.0;
   // Wall time [s since 1970] the learned state kept in the state directory was saved; NaN when
   // none is. The service fills it: it is the one that saves (views/snapshot.hpp).
   double learned_state_saved_unix = io::kNoValue;
@@ -148,6 +156,9 @@ class ActuatorMonitor {
 
  private:
   void decide(double t, const EventPublisher& publish);
+  // Accounts one hop at source time t as judged or not, and announces a long spell without.
+  void track_judging(double t, bool judged, detect::NotJudgedReason reason,
+                     const EventPublisher& publish);
   io::Event alarm_event(io::EventKind kind, double t) const;
   // outage: every checked channel's raw value is missing in this sample.
   void check_sensor_faults(double t, bool outage, const EventPublisher& publish);
@@ -209,7 +220,7 @@ class ActuatorMonitor {
   bool mode_out_of_band_;
   bool mode_judged_ = false;
   double healthy_index_ratio_ = io::kNoValue;
-  bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision
+  bool announce_blind_ = false;          // a restored blind verdict, announced at the next decision
   capture::ByRole<int> check_slot_{-1};  // by checked role, its index into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {
@@ -233,6 +244,12 @@ class ActuatorMonitor {
   double protected_from_ = io::kNoValue;  // source time of the first decision (expected)
   std::uint64_t relearns_ = 0;
   double learning_ended_t_ = io::kNoValue;
+  // Judging (ActuatorStatus::judged ...); not_judged_announced_: a not_judged event is out.
+  bool judged_ = false;
+  detect::NotJudgedReason not_judged_reason_ = detect::NotJudgedReason::learning;
+  double not_judged_since_ = io::kNoValue;
+  double judged_seconds_ = 0.0, decided_seconds_ = 0.0;
+  bool not_judged_announced_ = false;
 };
 
 }  // namespace leakmon::pipeline

@@ -16,6 +16,8 @@ struct AlarmSettings {
   double on_delay_s = 0.0;
   double off_delay_s = 0.0;
   bool latching = false;
+  // A detector not judging for longer than this [s] is announced (event not_judged).
+  double not_judged_event_seconds = 600.0;
 };
 
 enum class AlarmState {

@@ -41,6 +41,9 @@ std::string to_log_line(const io::Event& event) {
   if (std::isfinite(event.protected_from)) {
     line += fmt::format(" protected_from={:.3f}s", event.protected_from);
   }
+  if (std::isfinite(event.not_judged_since)) {
+    line += fmt::format(" not_judged_since={:.3f}s", event.not_judged_since);
+  }
   if (!event.message.empty()) line += fmt::format(": {}", event.message);
   // Event text can carry configuration and device content: no raw escape sequences in the log.
   return config::printable(line, 4000);
@@ -73,7 +76,7 @@ void LogEventSink::publish(const io::Event& event) {
   const auto level =
       (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
        event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected ||
-       event.kind == io::EventKind::detection_blind ||
+       event.kind == io::EventKind::detection_blind || event.kind == io::EventKind::not_judged ||
        event.kind == io::EventKind::state_discarded ||
        event.kind == io::EventKind::state_save_failed)
           ? spdlog::level::warn

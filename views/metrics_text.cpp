@@ -96,6 +96,21 @@ constexpr MetricFamily kDetectionBlind{
     "1 when a pressure-only detector's rig showed no hydraulic mode to see a leak by while it "
     "learned",
     Type::gauge};
+// Judging (detect::NotJudgedReason): whether the newest decision could have revealed a leak, and
+// why not as a state set over every reason; two counters whose ratio is the judged share.
+constexpr MetricFamily kJudged{
+    "leakmon_judged",
+    "1 while the detector judges (its decisions could reveal a leak), 0 while it does not",
+    Type::gauge};
+constexpr MetricFamily kNotJudgedReason{"leakmon_not_judged_reason",
+                                        "why the detector does not judge (1: current reason)",
+                                        Type::gauge};
+constexpr MetricFamily kJudgedSeconds{"leakmon_judged_seconds_total",
+                                      "source seconds of decisions that judged", Type::counter};
+constexpr MetricFamily kDecidedSeconds{
+    "leakmon_decided_seconds_total",
+    "source seconds of decisions (judged or not, held back by a sensor fault included)",
+    Type::counter};
 constexpr MetricFamily kLearnedStateAge{
     "leakmon_learned_state_age_seconds",
     "seconds since the learned state kept in the state directory was saved", Type::gauge};
@@ -322,6 +337,25 @@ void actuator_metrics(PrometheusText& out, std::span<const ActuatorStatus> actua
       true);
   per_actuator_gauge(out, actuators, kDetectionBlind,
                      [](const ActuatorStatus& a) { return flag(a.detection_blind); });
+  per_actuator_gauge(out, actuators, kJudged,
+                     [](const ActuatorStatus& a) { return flag(a.judged); });
+  out.family(kNotJudgedReason);
+  for (const auto& a : actuators) {
+    for (std::size_t r = 1; r < detect::kNotJudgedReasonNames.size(); ++r) {
+      out.sample(
+          kNotJudgedReason,
+          label("actuator", a.name) + "," + label("reason", detect::kNotJudgedReasonNames[r]),
+          flag(!a.judged && static_cast<std::size_t>(a.not_judged_reason) == r));
+    }
+  }
+  out.family(kJudgedSeconds);
+  for (const auto& a : actuators) {
+    out.sample(kJudgedSeconds, label("actuator", a.name), a.judged_seconds);
+  }
+  out.family(kDecidedSeconds);
+  for (const auto& a : actuators) {
+    out.sample(kDecidedSeconds, label("actuator", a.name), a.decided_seconds);
+  }
   out.family(kLearnedStateAge);
   for (const auto& a : actuators) {
     if (std::isfinite(a.learned_state_saved_unix)) {

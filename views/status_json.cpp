@@ -72,7 +72,7 @@ std::string features_json(const ServiceSnapshot& snapshot,
   json.string("actuator", actuator.name);
   write_fields(json, actuator_fields(), actuator,
                {"index_p1_pa", "score", "leak_lpm_per_mpa", "leak_lpm_per_mpa_ci95", "alarm_state",
-                "learning"});
+                "learning", "judged", "not_judged_reason"});
   // Renamed; kept for one release: the p1 index in kPa (views/vocabulary.cpp renamed_fields()).
   json.number("index", actuator.index_p1 / 1e3);
   json.number("unix_time", snapshot.unix_time);
@@ -197,6 +197,13 @@ std::string status_text_from_json(std::string_view json) {
                            text(c["spikes_rejected"]));
       }
       if (a["suspended"].as<bool>()) out += "  leak decision suspended (sensor fault)\n";
+      // A status from a daemon before judging was reported has no `judged`: say nothing.
+      if (a["judged"] && !a["judged"].as<bool>() && state != "learning") {
+        out +=
+            fmt::format("  NOT JUDGING: {} since t {} (judged {} of the time)\n",
+                        text(a["not_judged_reason"]), maybe(number(a["not_judged_since"]), " s", 1),
+                        maybe(100.0 * number(a["judged_share"]), " %", 0));
+      }
       if (a["detection_blind"] && a["detection_blind"].as<bool>()) {
         out += fmt::format(
             "  BLIND: the hydraulic mode hardly showed while learning (median index {:.1f} x "

@@ -26,6 +26,19 @@ constexpr A kActuatorFields[] = {
     {"suspended", "", +[](const ActuatorStatus& a) { return a.suspended; }},
     {"detection_blind", "", +[](const ActuatorStatus& a) { return a.detection_blind; }},
     {"mode_visibility", "", +[](const ActuatorStatus& a) { return a.mode_visibility; }},
+    // Whether the newest decision could have revealed a leak; why not (null while judging);
+    // the source time it stopped; the share of decided time judged since the start.
+    {"judged", "", +[](const ActuatorStatus& a) { return a.judged; }},
+    {"not_judged_reason", "",
+     +[](const ActuatorStatus& a) {
+       return a.judged ? std::string_view() : detect::to_string(a.not_judged_reason);
+     }},
+    {"not_judged_since", "s",
+     +[](const ActuatorStatus& a) { return a.judged ? kNaN : a.not_judged_since; }},
+    {"judged_share", "",
+     +[](const ActuatorStatus& a) {
+       return a.decided_seconds > 0.0 ? a.judged_seconds / a.decided_seconds : kNaN;
+     }},
     {"t", "s", +[](const ActuatorStatus& a) { return a.t; }},
     {"index_p1_pa", "Pa", +[](const ActuatorStatus& a) { return a.index_p1; }},
     {"index_p2_pa", "Pa", +[](const ActuatorStatus& a) { return a.index_p2; }},

@@ -91,19 +91,23 @@ TEST(LearningMessages, RunLogsTheDetectorAndTheEndOfLearning) {
                            "  - name: cylinder\n"
                            "    channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x}\n"
                            "    detector: {kind: default, options: {settle_seconds: 1, "
-                           "learn_seconds: 2}}\n"
+                           "learn_seconds: 10}}\n"
                            "state: {directory: ''}\n"
                            "metrics: {port: 0}\n";
   // Real time: on a loaded machine missed cycles make gaps, which delay the end of learning.
-  const Invocation daemon = run("run --config " + config + " --duration 12");
+  // The flow balance learns only once its blocks at rest cover three distinct loads (issue 23):
+  // 10 s of the paper's steps (levels held 0.5-4 s) do; a shorter period might not, and then
+  // starts over.
+  const Invocation daemon = run("run --config " + config + " --duration 30");
   ASSERT_EQ(daemon.status, 0) << daemon.output;
   EXPECT_NE(daemon.output.find("cylinder: detector flow_balance (default for p1, p2, u, x); "
-                               "learns the healthy rig during its first 3.8 s of data"),
+                               "learns the healthy rig during its first 11.8 s of data"),
             std::string::npos)
       << daemon.output;
-  // Not before the planned 3.8 s of data (to the hop); later when cycles were missed.
+  // Not before the planned 11.8 s of data (to the hop); later when cycles were missed or the
+  // first period lacked loads.
   const double ended = number_after(daemon.output, "cylinder: learned the healthy rig until t = ");
-  EXPECT_GE(ended, 3.7) << daemon.output;
+  EXPECT_GE(ended, 11.7) << daemon.output;
 }
 
 }  // namespace

@@ -102,6 +102,24 @@ TEST(DaemonConfig, DeadbandMustBeADeadband) {
   EXPECT_NE(e.find("deadband"), std::string::npos) << e;
 }
 
+// Issue 23: how long a detector may not judge before the daemon says so; default 600 s, checked
+// at its key.
+TEST(DaemonConfig, NotJudgedEventSecondsIsReadAndChecked) {
+  const auto defaults = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) + "actuators: [{name: a, channels: {p1: p1}}]\n", "rig.yaml"));
+  EXPECT_EQ(defaults.actuators.at(0).alarm.not_judged_event_seconds, 600.0);
+  const auto set = parse_config(config::ConfigNode::load_string(
+      std::string(kDriver) +
+          "actuators: [{name: a, channels: {p1: p1}, alarm: {not_judged_event_seconds: 120}}]\n",
+      "rig.yaml"));
+  EXPECT_EQ(set.actuators.at(0).alarm.not_judged_event_seconds, 120.0);
+  const auto e = error_of(
+      std::string(kDriver) +
+      "actuators: [{name: a, channels: {p1: p1}, alarm: {not_judged_event_seconds: -5}}]\n");
+  EXPECT_NE(e.find("rig.yaml:2:"), std::string::npos) << e;
+  EXPECT_NE(e.find("not_judged_event_seconds"), std::string::npos) << e;
+}
+
 TEST(DaemonConfig, ReferencesMustExist) {
   EXPECT_NE(error_of(std::string(kDriver) + "actuators: [{name: a, channels: {p1: pump.p1}}]\n")
                 .find("no driver named 'pump'"),

@@ -55,9 +55,12 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 
 TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   const std::string dir = test::scratch_dir("daemon_process_lifecycle");
-  constexpr double kOnset = 12.0;
+  // The flow balance learns once a period's rest blocks cover three distinct loads (issue 23):
+  // on this capture the first 6 s period does not, the second (to 13.8 s) does, so the leak
+  // opens after that.
+  constexpr double kOnset = 18.0;
   sim::Scenario scenario = sim::preset("paper-fig10", 5);
-  scenario.duration_s = 26.0;
+  scenario.duration_s = 32.0;
   scenario.effects.internal_leakage->onset_s = kOnset;
   const capture::Capture capture = sim::simulate(scenario);
   capture::write_capture(dir + "/capture.csv", capture);
@@ -80,6 +83,9 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   const auto metrics = http::http_request("127.0.0.1", port, "GET", "/metrics").body;
   EXPECT_NE(metrics.find("leakmon_build_info{version="), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_ring_drops_total{group=\"main\"}"), std::string::npos);
+  // Judging (issue 23): the gauge and both counters, per actuator.
+  EXPECT_NE(metrics.find("leakmon_judged{actuator=\"cyl\"}"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("leakmon_decided_seconds_total{actuator=\"cyl\"}"), std::string::npos);
   EXPECT_NE(metrics.find("leakmon_loop_wakeup_latency_seconds_bucket"), std::string::npos);
   // Each transducer channel's NE 107 status (detect/sensor_plausibility.hpp), in both texts.
   EXPECT_NE(metrics.find("leakmon_sensor_status{actuator=\"cyl\",channel=\"p1\",status=\"ok\"} 1"),
@@ -115,7 +121,7 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
 
   // The leak raises the (latching) alarm; the operator acknowledges it over HTTP.
   ASSERT_TRUE(test::eventually(
-      [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_raised") >= 1; }, 25s))
+      [&] { return count_of(test::DaemonProcess::read_file(events), "alarm_raised") >= 1; }, 31s))
       << daemon.log();
   const auto ack = http::http_request("127.0.0.1", port, "POST", "/ack?actuator=cyl");
   EXPECT_EQ(ack.status, 200) << ack.body;

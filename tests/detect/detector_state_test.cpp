@@ -105,6 +105,8 @@ TEST_P(DetectorRestart, RestoredDetectorDecidesAsTheOneThatNeverStopped) {
     ASSERT_TRUE(same(a.index, b.index)) << o.t;
     ASSERT_TRUE(same(a.leak_coefficient, b.leak_coefficient)) << o.t;
     ASSERT_TRUE(same(a.leak_coefficient_ci, b.leak_coefficient_ci)) << o.t;
+    ASSERT_EQ(a.judged, b.judged) << o.t;
+    ASSERT_EQ(a.not_judged_reason, b.not_judged_reason) << o.t;
     ++compared;
     if (b.score >= restored->raise_threshold()) ++raised;
     if (c.score >= relearning->raise_threshold()) ++relearning_raised;

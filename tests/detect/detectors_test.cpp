@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "detect/factory.hpp"
+#include "detect/flow_balance_detector.hpp"
 #include "detect/fused_detector.hpp"
 #include "tests/detect/synthetic_pressures.hpp"
 #include "tests/detect/synthetic_rig.hpp"
@@ -71,16 +72,19 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
     keys.insert(keys.begin(), learning.begin(), learning.end());
     return keys;
   };
-  const std::vector<std::string> index =
-      with_learning({"design_drop", "false_alarms_per_hour", "block_seconds", "supply_pressure",
-                     "tank_pressure", "min_drop", "temperature_prior", "temperature_prior_sigma",
-                     "drift_guard_seconds", "drift_window_seconds", "supply_settle_seconds",
-                     "oil_grade", "oil_viscosity_40", "oil_viscosity_100"});
+  const std::vector<std::string> index = with_learning(
+      {"design_drop", "false_alarms_per_hour", "block_seconds", "supply_pressure", "tank_pressure",
+       "min_drop", "temperature_prior", "temperature_prior_sigma", "no_excitation_share",
+       "drift_guard_seconds", "drift_window_seconds", "supply_settle_seconds", "oil_grade",
+       "oil_viscosity_40", "oil_viscosity_100"});
   const std::vector<std::string> flow =
       with_learning({"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
                      "valve_coefficient_uncertainty", "piston_area", "rest_speed", "design_leak",
                      "false_alarms_per_hour", "block_seconds", "sizing_seconds", "min_leak",
-                     "drift_guard_seconds", "drift_window_seconds", "estimate_supply", "oil_grade",
+                     "drift_guard_seconds", "drift_window_seconds", "estimate_supply",
+                     // issue 23: learning waits for excitation, judged state
+                     "min_rest_loads", "rest_load_tolerance", "max_excitation_wait_seconds",
+                     "limit_to_learned", "no_load_pressure", "judged_memory_seconds", "oil_grade",
                      "oil_viscosity_40", "oil_viscosity_100"});
   std::vector<std::string> fused = index;
   for (const auto& key : flow) {
@@ -191,6 +195,111 @@ TEST(FlowBalanceDetector, QuietOnAHealthyRigWithStrongNullLeak) {
   const test::DetectorRun r = test::run_detector(*detector, rig, 1200.0);
   EXPECT_LT(r.max_healthy_score, detector->raise_threshold());
   EXPECT_NEAR(r.last.leak_coefficient, 0.0, r.last.leak_coefficient_ci + 0.1e-12);
+}
+
+// Issue 23: a rig held at one position gives the flow balance one load, from which the healthy
+// command's fit against the load extrapolates wildly. Learning waits until blocks at rest cover
+// min_rest_loads distinct loads, says so meanwhile, and then judges without a false alarm.
+// `hold_at` sets the synthetic rig to rest at x for `seconds` from now.
+void hold_at(test::SyntheticRig& rig, double x, double seconds) {
+  rig.target = x;
+  rig.x = x;
+  rig.hold_left = seconds;
+}
+
+TEST(FlowBalanceExcitation, AHoldIsNotLearnedFromAndTheWaitIsSaid) {
+  auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  hold_at(rig, 0.02, 300.0);
+  std::size_t waiting = 0, held = 0;
+  while (rig.t < 300.0) {
+    const Decision d = detector->update(rig.next());
+    ++held;
+    EXPECT_TRUE(d.learning) << rig.t;
+    EXPECT_FALSE(d.judged) << rig.t;
+    if (d.not_judged_reason == NotJudgedReason::waiting_for_excitation) ++waiting;
+  }
+  // From the end of the first learning period (92 s) on: waiting, not learning.
+  EXPECT_GT(static_cast<double>(waiting), 0.6 * static_cast<double>(held));
+  double learned_at = -1.0, judged_at = -1.0;
+  double max_score = 0.0;
+  while (rig.t < 900.0) {
+    const Decision d = detector->update(rig.next());
+    if (!d.learning && learned_at < 0) learned_at = rig.t;
+    if (d.judged && judged_at < 0) judged_at = rig.t;
+    if (!std::isnan(d.score)) max_score = std::max(max_score, d.score);
+  }
+  ASSERT_GT(learned_at, 300.0);
+  EXPECT_LT(learned_at, 300.0 + 2 * 92.0);  // the first period that holds the steps' loads
+  EXPECT_GT(judged_at, learned_at);
+  EXPECT_LT(judged_at, learned_at + 10.0);
+  EXPECT_LT(max_score, detector->raise_threshold());
+}
+
+TEST(FlowBalanceExcitation, WaitingTooLongSaysItCannotLearnRatherThanLearningTheHold) {
+  FlowBalanceOptions options;
+  options.max_excitation_wait_seconds = 180.0;
+  FlowBalanceDetector detector(options, 0.04);
+  test::SyntheticRig rig;
+  hold_at(rig, 0.02, 1e9);
+  Decision d;
+  while (rig.t < 400.0) d = detector.update(rig.next());
+  EXPECT_FALSE(d.learning);
+  EXPECT_FALSE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::cannot_learn);
+  EXPECT_TRUE(std::isnan(d.score));
+  EXPECT_EQ(to_string(d.not_judged_reason), "cannot_learn");
+}
+
+// After learning on the steps: a hold beyond every learned load is not judged, and neither is
+// one near the spring's rest (|p1 - p2| = 0.38 MPa: no leak flow), while the steps are.
+TEST(FlowBalanceExcitation, HoldsOutsideTheLearnedLoadsOrWithoutLoadAreNotJudged) {
+  auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  Decision d;
+  while (rig.t < 200.0) d = detector->update(rig.next());
+  ASSERT_FALSE(d.learning);
+  EXPECT_TRUE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::none);
+  hold_at(rig, 0.09, 60.0);  // 11.4 MPa; the steps reach 6.3 MPa
+  while (rig.t < 259.0) d = detector->update(rig.next());
+  EXPECT_FALSE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::outside_learned_loads);
+  hold_at(rig, 0.003, 60.0);
+  while (rig.t < 319.0) d = detector->update(rig.next());
+  EXPECT_FALSE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::no_load);
+  while (rig.t < 360.0) d = detector->update(rig.next());
+  EXPECT_TRUE(d.judged);
+}
+
+// Without the limit the far hold is judged: what limit_to_learned changes (so the test above
+// can fail).
+TEST(FlowBalanceExcitation, WithoutTheLimitAFarHoldIsJudged) {
+  FlowBalanceOptions options;
+  options.limit_to_learned = false;
+  FlowBalanceDetector detector(options, 0.04);
+  test::SyntheticRig rig;
+  Decision d;
+  while (rig.t < 200.0) d = detector.update(rig.next());
+  hold_at(rig, 0.09, 60.0);
+  while (rig.t < 259.0) d = detector.update(rig.next());
+  EXPECT_TRUE(d.judged);
+}
+
+// Pressure-only: an index far below its learned level (no hydraulic mode rung) is not judged.
+TEST(IndexCusumDetector, AnIndexFarBelowItsLearnedLevelIsNotJudged) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  Decision d;
+  while (rig.t < 200.0) d = detector->update(rig.next());
+  ASSERT_FALSE(d.learning);
+  EXPECT_TRUE(d.judged);
+  detect::Observation quiet = rig.next();
+  quiet.index_p1 = quiet.index_p2 = 0.2 * d.baseline;
+  d = detector->update(quiet);
+  EXPECT_FALSE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::no_excitation);
 }
 
 // MODEL.md's valve bias and overlap present from the start: the learned healthy relation takes

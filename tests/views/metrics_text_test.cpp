@@ -243,8 +243,16 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   fresh.learning_seconds_left = 37.5;
   fresh.mode_visibility = 1.6;  // learned on a rig whose hydraulic mode did not show
   fresh.detection_blind = true;
+  // Judging: `lift` judges (a quarter of its time so far), `clamp` has been in a sine block.
+  fresh.judged = false;
+  fresh.not_judged_reason = detect::NotJudgedReason::in_motion;
+  fresh.decided_seconds = 300.0;
   std::vector<pipeline::ActuatorStatus> actuators = {leaking_actuator(), fresh};
   actuators[0].learned_state_saved_unix = 1000.0;
+  actuators[0].judged = true;
+  actuators[0].not_judged_reason = detect::NotJudgedReason::none;
+  actuators[0].judged_seconds = 30.0;
+  actuators[0].decided_seconds = 120.0;
   PrometheusText out;
   actuator_metrics(out, actuators, 1042.5);
   const std::string text = out.text();
@@ -284,6 +292,22 @@ TEST(MetricsText, ActuatorFamiliesCarryLeakSizeTemperatureSensorStatusAndStateAg
   EXPECT_EQ(lines_starting(text, "leakmon_hydraulic_mode_visibility{"), 1u);
   EXPECT_EQ(value_of(text, "leakmon_detection_blind{actuator=\"clamp\"}"), "1");
   EXPECT_EQ(value_of(text, "leakmon_detection_blind{actuator=\"lift\"}"), "0");
+
+  EXPECT_EQ(value_of(text, "leakmon_judged{actuator=\"lift\"}"), "1");
+  EXPECT_EQ(value_of(text, "leakmon_judged{actuator=\"clamp\"}"), "0");
+  EXPECT_EQ(value_of(text, "leakmon_not_judged_reason{actuator=\"clamp\",reason=\"in_motion\"}"),
+            "1");
+  EXPECT_EQ(value_of(text, "leakmon_not_judged_reason{actuator=\"clamp\",reason=\"learning\"}"),
+            "0");
+  EXPECT_EQ(value_of(text, "leakmon_not_judged_reason{actuator=\"lift\",reason=\"in_motion\"}"),
+            "0");
+  // Every reason but `none`, per actuator: a state set Prometheus can sum over.
+  EXPECT_EQ(lines_starting(text, "leakmon_not_judged_reason{"),
+            2u * (detect::kNotJudgedReasonNames.size() - 1));
+  EXPECT_EQ(value_of(text, "leakmon_judged_seconds_total{actuator=\"lift\"}"), "30");
+  EXPECT_EQ(value_of(text, "leakmon_decided_seconds_total{actuator=\"lift\"}"), "120");
+  EXPECT_EQ(value_of(text, "leakmon_judged_seconds_total{actuator=\"clamp\"}"), "0");
+  EXPECT_NE(text.find("# TYPE leakmon_judged_seconds_total counter"), std::string::npos);
 
   EXPECT_EQ(value_of(text, "leakmon_learned_state_age_seconds{actuator=\"lift\"}"), "42.5");
   // No saved state: no age sample (not a zero that would read as "just saved").

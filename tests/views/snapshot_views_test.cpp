@@ -100,6 +100,10 @@ ServiceSnapshot hand_filled() {
   a.channels.push_back({"p1", io::DeviceStatus::ok, detect::SensorFault::none, 2});
   a.channels.push_back({"p2", io::DeviceStatus::failure, detect::SensorFault::frozen, 0});
   a.relearns = 1;
+  a.judged = true;
+  a.not_judged_reason = detect::NotJudgedReason::none;
+  a.judged_seconds = 45.0;
+  a.decided_seconds = 60.0;
   a.learned_state_saved_unix = 1800000040.25;  // 60 s before the fill
   s.actuators.push_back(a);
 
@@ -111,6 +115,8 @@ ServiceSnapshot hand_filled() {
   b.learning_seconds_left = 22.3;
   b.index_p1 = 31000.0;
   b.index_p2 = 29000.0;
+  b.not_judged_reason = detect::NotJudgedReason::learning;
+  b.not_judged_since = 0.04;
   s.actuators.push_back(b);
   return s;
 }
@@ -221,6 +227,30 @@ TEST(SnapshotViews, StatusFromTheSnapshotInTheOneVocabulary) {
   EXPECT_EQ(b["state"].as<std::string>(), "learning");
   EXPECT_DOUBLE_EQ(b["learning_seconds_left"].as<double>(), 22.3);
   EXPECT_TRUE(b["leak_lpm_per_mpa"].IsNull()) << "null, never NaN";
+  // Judging: `cyl 1` judges, 45 of 60 s; `press` does not, since it started learning.
+  EXPECT_TRUE(a["judged"].as<bool>());
+  EXPECT_TRUE(a["not_judged_reason"].IsNull());
+  EXPECT_TRUE(a["not_judged_since"].IsNull());
+  EXPECT_DOUBLE_EQ(a["judged_share"].as<double>(), 0.75);
+  EXPECT_FALSE(b["judged"].as<bool>());
+  EXPECT_EQ(b["not_judged_reason"].as<std::string>(), "learning");
+  EXPECT_DOUBLE_EQ(b["not_judged_since"].as<double>(), 0.04);
+  EXPECT_TRUE(b["judged_share"].IsNull()) << "nothing decided yet";
+}
+
+// `leakmon status` names a detector that does not judge outside learning (issue 23).
+TEST(SnapshotViews, StatusTextSaysWhenADetectorDoesNotJudge) {
+  ServiceSnapshot s = hand_filled();
+  s.actuators[0].state = pipeline::AlarmState::normal;
+  s.actuators[0].judged = false;
+  s.actuators[0].not_judged_reason = detect::NotJudgedReason::in_motion;
+  s.actuators[0].not_judged_since = 601.2;
+  const std::string text = status_text_from_json(status_json(s));
+  EXPECT_NE(text.find("  NOT JUDGING: in_motion since t 601.2 s (judged 75 % of the time)"),
+            std::string::npos)
+      << text;
+  // Learning has its own line.
+  EXPECT_EQ(text.find("NOT JUDGING: learning"), std::string::npos) << text;
 }
 
 TEST(SnapshotViews, StatusTextReadsThisAndThePreviousVocabulary) {
@@ -246,13 +276,15 @@ TEST(SnapshotViews, FeatureMessageFromTheSnapshot) {
             fmt::format(R"({{"t": 61.998, "actuator": "cyl 1", "index_p1_pa": 25849.3, )"
                         R"("score": 1.97, "leak_lpm_per_mpa": {}, "leak_lpm_per_mpa_ci95": {}, )"
                         R"("alarm_state": "active_unacknowledged", "learning": false, )"
-                        R"("index": {}, "unix_time": 1800000100.25}})",
+                        R"("judged": true, "index": {}, "unix_time": 1800000100.25}})",
                         units::lpm_per_mpa(2.5e-12), units::lpm_per_mpa(1.0e-13), 25849.3 / 1e3));
   // What is not known yet is left out, as in the events.
   const std::string learning = features_json(s, s.actuators[1]);
   EXPECT_EQ(learning.find("score"), std::string::npos) << learning;
   EXPECT_EQ(learning.find("leak_lpm_per_mpa"), std::string::npos) << learning;
   EXPECT_NE(learning.find(R"("index": 31)"), std::string::npos) << learning;
+  EXPECT_NE(learning.find(R"("judged": false, "not_judged_reason": "learning")"), std::string::npos)
+      << learning;
 }
 
 // The human form from a document as the previous release wrote it (`leakmon status` of this

@@ -116,11 +116,14 @@ function createActuator(a) {
   blind.title = "The pressure-only detector sees a leak through the hydraulic mode, which " +
     "hardly showed above the transducer noise while it learned (seal friction, much air). " +
     "No leak alarm can come from it; acquire the valve command and the position.";
+  // The detector cannot see a leak now (a hold, a sine block, loads it never learned): a quiet
+  // alarm then says nothing about the rig.
+  const notJudged = el("span", "badge warn not-judged", "not judging");
   const ack = el("button", "ack", "Acknowledge");
   ack.type = "button";
   ack.addEventListener("click", () => acknowledge(a.name, result));
   const result = el("span", "ack-result", "");
-  title.append(alarm, learning, suspended, blind, ack, result);
+  title.append(alarm, learning, suspended, blind, notJudged, ack, result);
   card.appendChild(title);
 
   const tiles = el("div", "tiles");
@@ -147,7 +150,7 @@ function createActuator(a) {
   const kpa = (v) => scaled(v, 1e3);
   const mpa = (v) => scaled(v, 1e6);
   const entry = {
-    card, alarm, learning, suspended, blind, ack, result, tiles: t, data, charts: [],
+    card, alarm, learning, suspended, blind, notJudged, ack, result, tiles: t, data, charts: [],
   };
   entry.build = [
     () => [data.time, data.index_p1_pa.map(kpa), data.index_p2_pa.map(kpa)],
@@ -190,6 +193,11 @@ function updateActuator(a) {
   entry.learning.hidden = !a.learning;
   entry.suspended.hidden = !a.suspended;
   entry.blind.hidden = !a.detection_blind;
+  // Learning has its own badge; a status without `judged` (an older daemon) shows none.
+  entry.notJudged.hidden = a.judged !== false || a.learning;
+  entry.notJudged.textContent = "not judging: " + (a.not_judged_reason || "") +
+    (Number.isFinite(a.not_judged_since) ? " since t " + a.not_judged_since.toFixed(0) + " s" : "");
+  card.dataset.judged = String(a.judged);
   entry.ack.disabled = a.alarm_state === "normal";
   if (a.trend) appendColumns(entry.data, a.trend, TREND_COLUMNS);
   const data = entry.data;
