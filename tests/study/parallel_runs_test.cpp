@@ -3,6 +3,7 @@
 // run that throws stops the pool and is reported by its id.
 #include "study/parallel_runs.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -33,10 +34,10 @@ TEST(RunInParallel, ResultsInTheOrderOfTheRunsForAnyNumberOfThreads) {
           EXPECT_EQ(total, runs.size());
           seen.push_back(done);
         },
-        [](const Case& run) { return "r" + std::to_string(run.id); });
+        [](const Case& run) { return fmt::format("r{}", run.id); });
     ASSERT_EQ(results.size(), runs.size()) << jobs;
     for (std::size_t i = 0; i < runs.size(); ++i) {
-      EXPECT_EQ(results[i], "r" + std::to_string(runs[i].id)) << jobs;
+      EXPECT_EQ(results[i], fmt::format("r{}", runs[i].id)) << jobs;
     }
     ASSERT_EQ(seen.size(), runs.size()) << jobs;
     for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i + 1) << jobs;
