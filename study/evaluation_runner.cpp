@@ -5,18 +5,14 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
-#include <mutex>
-#include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
-#include "pipeline/replay.hpp"
 #include "detect/factory.hpp"
+#include "pipeline/replay.hpp"
 #include "sim/random.hpp"
 #include "sim/sensor_faults.hpp"
 #include "sim/simulate.hpp"
@@ -124,7 +120,7 @@ config::ConfigNode detector_options(const EvaluationOptions& options) {
 }
 
 pipeline::DaemonConfig evaluation_config(const capture::Capture& capture,
-                                       const EvaluationOptions& options) {
+                                         const EvaluationOptions& options) {
   pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
   const pipeline::ActuatorConfig base = config.actuators.at(0);
   config.actuators.clear();
@@ -207,31 +203,8 @@ RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options) {
 
 std::vector<RunResult> run_evaluation(const std::vector<RunSpec>& runs,
                                       const EvaluationOptions& options, const Progress& progress) {
-  std::vector<RunResult> results(runs.size());
-  std::atomic<std::size_t> next{0};
-  std::size_t done = 0;
-  std::mutex lock_progress;
-  std::string failure;
-  auto worker = [&] {
-    for (std::size_t i = next++; i < runs.size(); i = next++) {
-      try {
-        results[i] = evaluate_run(runs[i], options);
-      } catch (const std::exception& e) {
-        std::lock_guard lock(lock_progress);
-        failure = fmt::format("run {}: {}", runs[i].id, e.what());
-        next = runs.size();
-        return;
-      }
-      std::lock_guard lock(lock_progress);
-      ++done;
-      if (progress) progress(done, runs.size());
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 0; j < options.jobs; ++j) threads.emplace_back(worker);
-  for (auto& t : threads) t.join();
-  if (!failure.empty()) throw std::runtime_error(failure);
-  return results;
+  return run_in_parallel<RunResult>(runs, options.jobs, progress,
+                                    [&](const RunSpec& run) { return evaluate_run(run, options); });
 }
 
 }  // namespace leakmon::study

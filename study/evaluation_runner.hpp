@@ -13,6 +13,7 @@
 #include "pipeline/config.hpp"
 #include "study/case_generation.hpp"
 #include "study/evaluation_options.hpp"
+#include "study/parallel_runs.hpp"
 
 namespace leakmon::study {
 
@@ -55,13 +56,10 @@ config::ConfigNode detector_options(const EvaluationOptions& options);
 
 // The daemon configuration that replays `capture`: one actuator per candidate and threshold.
 pipeline::DaemonConfig evaluation_config(const capture::Capture& capture,
-                                       const EvaluationOptions& options);
+                                         const EvaluationOptions& options);
 
 // Simulates and replays one run (and writes its capture when options.keep_captures names it).
 RunResult evaluate_run(const RunSpec& spec, const EvaluationOptions& options);
-
-// Called after each finished run, one call at a time.
-using Progress = std::function<void(std::size_t done, std::size_t total)>;
 
 // Every run on options.jobs threads; results in the order of `runs`. The first run that throws
 // stops the others and is rethrown as std::runtime_error("run ID: what").

@@ -4,11 +4,7 @@
 #include <fmt/os.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <mutex>
-#include <stdexcept>
-#include <thread>
 #include <variant>
 
 #include "pipeline/mode_visibility.hpp"
@@ -150,31 +146,9 @@ RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& opti
 std::vector<RigRunResult> run_rig_evaluation(const std::vector<RunSpec>& runs,
                                              const EvaluationOptions& options,
                                              const Progress& progress) {
-  std::vector<RigRunResult> results(runs.size());
-  std::atomic<std::size_t> next{0};
-  std::size_t done = 0;
-  std::mutex lock;
-  std::string failure;
-  auto worker = [&] {
-    for (std::size_t i = next++; i < runs.size(); i = next++) {
-      try {
-        results[i] = evaluate_rig_run(runs[i], options);
-      } catch (const std::exception& e) {
-        std::lock_guard guard(lock);
-        failure = fmt::format("run {}: {}", runs[i].id, e.what());
-        next = runs.size();
-        return;
-      }
-      std::lock_guard guard(lock);
-      ++done;
-      if (progress) progress(done, runs.size());
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 0; j < options.jobs; ++j) threads.emplace_back(worker);
-  for (auto& t : threads) t.join();
-  if (!failure.empty()) throw std::runtime_error(failure);
-  return results;
+  return run_in_parallel<RigRunResult>(runs, options.jobs, progress, [&](const RunSpec& run) {
+    return evaluate_rig_run(run, options);
+  });
 }
 
 RigScore score_rig_candidate(const std::vector<RigRunResult>& results, std::size_t candidate,

@@ -10,9 +10,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <span>
 #include <sstream>
+#include <utility>
 
 #include "config/yaml_reader.hpp"
 #include "pipeline/event_log.hpp"
@@ -76,6 +79,28 @@ const Field<Row>& column_named(std::span<const Field<Row>> table, std::string_vi
     if (field.name == name) return field;
   }
   throw std::logic_error("views/vocabulary: no trend column named " + std::string(name));
+}
+
+// The "trend" member of one actuator or group: null before its first point, else the time
+// column, every column of `columns` and, for one release, the renamed columns under their old
+// names ({old name, name}).
+template <typename Series, typename Row>
+void write_trend(JsonWriter& json, const Series* series, double since,
+                 std::span<const Field<Row>> columns,
+                 std::initializer_list<std::pair<const char*, const char*>> renamed) {
+  if (series == nullptr) {
+    json.null("trend");
+    return;
+  }
+  const auto& ring = series->points;
+  const std::size_t from = first_after(ring, since);
+  json.begin_object("trend");
+  write_time_column(json, ring, from);
+  for (const auto& column : columns) write_column(json, column.name, ring, from, column);
+  for (const auto& [old_name, name] : renamed) {
+    write_column(json, old_name, ring, from, column_named(columns, name));
+  }
+  json.end_object();
 }
 
 }  // namespace
@@ -314,26 +339,14 @@ std::string OperatorView::trend_json(double since) const {
       json.end_object();
     }
     json.end_array();
-    const auto* series = history_.actuator(a.name);
-    if (series == nullptr) {
-      json.null("trend");
-    } else {
-      const auto& ring = series->points;
-      const std::size_t from = first_after(ring, since);
-      json.begin_object("trend");
-      write_time_column(json, ring, from);
-      for (const auto& column : trend_columns())
-        write_column(json, column.name, ring, from, column);
-      // Renamed; kept for one release.
-      for (const auto& [old_name, name] :
-           {std::pair{"index_p1", "index_p1_pa"}, std::pair{"index_p2", "index_p2_pa"},
-            std::pair{"p1", "p1_pa"}, std::pair{"p2", "p2_pa"},
-            std::pair{"oil_temperature", "oil_temperature_c"},
-            std::pair{"alarm", "alarm_state_code"}}) {
-        write_column(json, old_name, ring, from, column_named(trend_columns(), name));
-      }
-      json.end_object();
-    }
+    // Renamed columns; kept for one release.
+    write_trend(json, history_.actuator(a.name), since, trend_columns(),
+                {{"index_p1", "index_p1_pa"},
+                 {"index_p2", "index_p2_pa"},
+                 {"p1", "p1_pa"},
+                 {"p2", "p2_pa"},
+                 {"oil_temperature", "oil_temperature_c"},
+                 {"alarm", "alarm_state_code"}});
     json.end_object();
   }
   json.end_array();
@@ -346,21 +359,8 @@ std::string OperatorView::trend_json(double since) const {
     json.number("latency_mean_us", g.wakeup_latency.mean_us());
     json.number("latency_max_us", g.wakeup_latency.max_us());
     json.number("latency_p99_us", g.wakeup_latency.p99_us());
-    const auto* series = history_.group(g.name);
-    if (series == nullptr) {
-      json.null("trend");
-    } else {
-      const auto& ring = series->points;
-      const std::size_t from = first_after(ring, since);
-      json.begin_object("trend");
-      write_time_column(json, ring, from);
-      for (const auto& column : loop_trend_columns()) {
-        write_column(json, column.name, ring, from, column);
-      }
-      write_column(json, "latency_mean_us", ring, from,
-                   column_named(loop_trend_columns(), "wakeup_latency_mean_us"));
-      json.end_object();
-    }
+    write_trend(json, history_.group(g.name), since, loop_trend_columns(),
+                {{"latency_mean_us", "wakeup_latency_mean_us"}});
     json.end_object();
   }
   json.end_array();

@@ -23,14 +23,30 @@
 #    warmup, cooler, supply, sensor-faults, restart), every candidate detector on each (so about
 #    3 h per detector); every output file must be byte-identical.
 # --quick: the scenarios and presets only at their own length and fewer evaluate runs.
+# --only=LIST: only these parts, of replay (2), restarts (3) and evaluate (4), comma-separated.
+# --evaluate-args="ARGS": the `leakmon evaluate` options of part 4 instead of the ones below
+#   (give --seed and --jobs too), for a sample of chosen length and conditions.
 # Prints one line per comparison and a summary; exit status 1 when anything differs.
 set -euo pipefail
 
-BEFORE=$(realpath "${1:?usage: compare_events.sh BEFORE AFTER [WORKDIR] [--quick]}")
-AFTER=$(realpath "${2:?usage: compare_events.sh BEFORE AFTER [WORKDIR] [--quick]}")
-WORK=${3:-/tmp/leakmon-compare-events}
+usage="usage: compare_events.sh BEFORE AFTER [WORKDIR] [--quick] [--only=LIST] [--evaluate-args=ARGS]"
+BEFORE=$(realpath "${1:?$usage}")
+AFTER=$(realpath "${2:?$usage}")
+WORK=/tmp/leakmon-compare-events
 QUICK=0
-for arg in "$@"; do [[ $arg == --quick ]] && QUICK=1; done
+PARTS=replay,restarts,evaluate
+EVALUATE_ARGS=""
+for arg in "${@:3}"; do
+  case $arg in
+    --quick) QUICK=1 ;;
+    --only=*) PARTS=${arg#--only=} ;;
+    --evaluate-args=*) EVALUATE_ARGS=${arg#--evaluate-args=} ;;
+    --*) echo "$usage" >&2; exit 2 ;;
+    *) WORK=$arg ;;
+  esac
+done
+# part NAME: whether NAME was asked for.
+part() { [[ ,$PARTS, == *,$1,* ]]; }
 SOURCE=$(cd "$(dirname "$0")/../.." && pwd)
 mkdir -p "$WORK"
 cd "$WORK"
@@ -105,6 +121,7 @@ EOF
 # replay_both NAME CAPTURE VARIANT: the configuration above and the built-in default.
 replay_both() {
   local name=$1 capture=$2 variant=$3
+  part replay || return 0
   write_config "$capture" "$variant" >"$name.yaml"
   for who in before after; do
     local exe=$BEFORE
@@ -122,6 +139,7 @@ replay_both() {
 # restart NAME CAPTURE VARIANT FRACTION: cut the capture, learn on the first part, resume.
 restart() {
   local name=$1 capture=$2 variant=$3 fraction=$4
+  part restarts || return 0
   local header rows cut
   header=$(grep -c -E '^(#|t,)' "$capture")
   rows=$(($(wc -l <"$capture") - header))
@@ -161,6 +179,7 @@ restart() {
 
 echo "# leakmon compare_events: $BEFORE (before) vs $AFTER (after), in $WORK"
 
+if part replay || part restarts; then
 echo "## replay"
 for scenario in "$SOURCE"/sim/scenarios/*.yaml; do
   base=$(basename "$scenario" .yaml)
@@ -199,6 +218,9 @@ for preset in paper-fig10 paper-fig13 paper-fig16; do
   done
 done
 
+fi
+
+if part evaluate; then
 echo "## evaluate"
 # Healthy and leak runs cycle through the six conditions (each leak size's runs too); the
 # second six sensor-fault runs have a leak open during the fault.
@@ -207,6 +229,9 @@ evaluate=(--healthy-runs 6 --healthy-seconds 600 --runs-per-leak 6 --leaks 5e-13
   --seed 26 --jobs 2)
 [[ $QUICK == 1 ]] && evaluate=(--healthy-runs 2 --healthy-seconds 400 --runs-per-leak 1
   --leaks 1e-12,5e-12 --sensor-fault-runs 2 --conditions warmup,restart --seed 26 --jobs 2)
+# shellcheck disable=SC2206 # the options are words
+[[ -n $EVALUATE_ARGS ]] && evaluate=($EVALUATE_ARGS)
+echo "evaluate ${evaluate[*]}"
 for who in before after; do
   exe=$BEFORE
   [[ $who == after ]] && exe=$AFTER
@@ -221,6 +246,7 @@ echo "evaluate: $(grep -c '"id"' evaluate.before/runs.json) runs ($(grep -o '"op
   tr -d '"')), $(sed -nE \
   's/.*"seconds": ([0-9.e+]+),.*/\1/p' evaluate.before/runs.json |
   awk '{s += $1} END {printf "%.2f h simulated", s / 3600}')"
+fi
 
 echo "## summary: $same same, $different different"
 [[ $different == 0 ]]

@@ -4,49 +4,22 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "tests/support/leakmon_cli.hpp"
 #include "tests/support/paths.hpp"
 
 namespace leakmon {
 namespace {
 
-int run_leakmon(const std::string& args, const std::string& dir) {
-  const std::string command =
-      test::leakmon_binary() + " " + args + " > " + dir + "/leakmon.log 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using test::read_text;
+using test::run_leakmon;
 
-using Row = std::map<std::string, std::string>;
-
-std::vector<Row> read_tsv(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  std::vector<Row> rows;
-  auto split = [](const std::string& text) {
-    std::vector<std::string> fields;
-    std::stringstream s(text);
-    std::string field;
-    while (std::getline(s, field, '\t')) fields.push_back(field);
-    return fields;
-  };
-  if (std::getline(in, line)) header = split(line);
-  while (std::getline(in, line)) {
-    const auto fields = split(line);
-    Row row;
-    for (std::size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
+using Row = test::TsvRow;
+using test::read_tsv;
 
 const Row* find(const std::vector<Row>& rows, const std::string& detector, const std::string& leak,
                 bool design, const std::string& threshold = "") {
@@ -109,13 +82,6 @@ TEST(EvaluateCommand, SmallFixedSeedEvaluation) {
       previous = rate;
     }
   }
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 double sum_of(const std::vector<Row>& rows, const std::string& detector, const std::string& field,

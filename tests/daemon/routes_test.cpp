@@ -6,24 +6,12 @@
 
 #include <gtest/gtest.h>
 
-#include "http/http_target.hpp"
+#include "tests/support/http_request.hpp"
 
 namespace leakmon::daemon {
 namespace {
 
-// A request as the endpoint builds it from the request line (http/http_endpoint.cpp).
-http::HttpRequest request(std::string method, std::string_view target) {
-  const http::RequestTargetResult parsed = http::parse_request_target(target);
-  EXPECT_TRUE(parsed.target.has_value()) << target << ": " << parsed.error;
-  http::HttpRequest r;
-  r.method = std::move(method);
-  if (parsed.target) {
-    r.path = parsed.target->path;
-    r.query = parsed.target->query;
-    r.params = parsed.target->params;
-  }
-  return r;
-}
+using test::request;
 
 TEST(DaemonRoutes, AckIsStrictAboutItsParameters) {
   EXPECT_FALSE(ack_selection(request("POST", "/ack")).error);

@@ -22,17 +22,16 @@ import json
 import math
 import os
 import signal
-import socket
 import subprocess
 import sys
 import threading
 import time
 import urllib.parse
-import urllib.request
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from browser_page import free_port, headless_chromium, http_get, wait_for  # noqa: E402
 
 CONFIG = """\
 drivers: [{{name: rig, type: sim, scenario: healthy, seed: 7}}]
@@ -47,30 +46,6 @@ worker: {{priority: 0}}
 realtime: {{cpu_wakeup_latency_us: -1}}
 """
 ASSETS = ["/", "/live.js", "/live.css", "/favicon.svg", "/uplot.min.js", "/uplot.min.css"]
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def http_get(url):
-    with urllib.request.urlopen(url, timeout=5) as response:
-        return response.read(), response.headers.get("Content-Type")
-
-
-def wait_for(what, condition, timeout_s):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        try:
-            value = condition()
-            if value:
-                return value
-        except Exception:  # not there yet
-            pass
-        time.sleep(0.25)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
 
 
 def newest_finite(column):
@@ -193,13 +168,7 @@ def main():
     server = serve(assets, first, later, script, last_seq)
     base = f"http://127.0.0.1:{server.server_address[1]}/"
 
-    options = webdriver.ChromeOptions()
-    options.binary_location = "/usr/bin/chromium"
-    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                 "--window-size=1400,1000", "--no-first-run", "--disable-extensions"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    driver = headless_chromium("1400,1000")
     failures = []
 
     def check(condition, message):

@@ -15,15 +15,14 @@ a screenshot with the raised alarm (docs/figures/live-page.png is made this way)
 import argparse
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
-import urllib.request
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from browser_page import free_port, headless_chromium, http_text, wait_for  # noqa: E402
 
 LEAK_ONSET_S = 20.0
 FRICTION_SCENARIO = """\
@@ -64,30 +63,6 @@ realtime: {{cpu_wakeup_latency_us: -1}}
 """
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def http_get(url):
-    with urllib.request.urlopen(url, timeout=5) as response:
-        return response.read().decode()
-
-
-def wait_for(what, condition, timeout_s):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        try:
-            value = condition()
-            if value:
-                return value
-        except Exception:  # the daemon or the page is not there yet
-            pass
-        time.sleep(0.25)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
-
-
 def alarm_metric(metrics, state):
     # alarm_state is the alarm's ISA-18.2 state; `state` repeats it for one release.
     prefix = (f'leakmon_alarm_active{{actuator="cylinder",alarm="internal_leakage",'
@@ -122,16 +97,10 @@ def main():
     daemon = subprocess.Popen([args.leakmon, "run", "--config", config], stdout=log, stderr=log)
     driver = None
     try:
-        wait_for("the daemon's endpoint", lambda: http_get(base + "metrics"), 15)
+        wait_for("the daemon's endpoint", lambda: http_text(base + "metrics"), 15)
         started = time.monotonic()
 
-        options = webdriver.ChromeOptions()
-        options.binary_location = "/usr/bin/chromium"
-        for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                     "--window-size=1400,1500", "--no-first-run", "--disable-extensions"):
-            options.add_argument(flag)
-        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-        driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+        driver = headless_chromium("1400,1500")
         driver.get(base)
 
         card = wait_for("the actuator's card",
@@ -155,7 +124,7 @@ def main():
                  lambda: card.get_attribute("data-alarm-state") == "active_unacknowledged",
                  LEAK_ONSET_S + 30 - (time.monotonic() - started))
         print(f"alarm shown {time.monotonic() - started:.1f} s after the daemon started")
-        assert alarm_metric(http_get(base + "metrics"), "active_unacknowledged")
+        assert alarm_metric(http_text(base + "metrics"), "active_unacknowledged")
         wait_for("the alarm event in the page's event list",
                  lambda: driver.find_elements(By.CSS_SELECTOR, "#events tr.alarm_raised"), 10)
         leak = card.find_element(By.CSS_SELECTOR, ".leak").text
@@ -183,7 +152,7 @@ def main():
         assert button.is_enabled()
         button.click()
         wait_for("the daemon to record the acknowledgement",
-                 lambda: alarm_metric(http_get(base + "metrics"), "active_acknowledged"), 10)
+                 lambda: alarm_metric(http_text(base + "metrics"), "active_acknowledged"), 10)
         wait_for("the page to show it",
                  lambda: card.get_attribute("data-alarm-state") == "active_acknowledged", 10)
         with open(events) as f:

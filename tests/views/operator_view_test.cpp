@@ -16,7 +16,6 @@
 #include <fmt/format.h>
 
 #include "daemon/config.hpp"
-#include "http/http_target.hpp"
 #include "pipeline/replay.hpp"
 #include "pipeline/worker.hpp"
 #include "realtime/acquisition_loop.hpp"
@@ -24,25 +23,14 @@
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/support/http_request.hpp"
 #include "tests/support/paths.hpp"
 #include "views/operator_view.hpp"
 
 namespace leakmon::views {
 namespace {
 
-// A request as the endpoint builds it: the target parsed by the transport's one decoder.
-http::HttpRequest request(std::string method, std::string_view target) {
-  const http::RequestTargetResult parsed = http::parse_request_target(target);
-  EXPECT_TRUE(parsed.target.has_value()) << target << ": " << parsed.error;
-  http::HttpRequest r;
-  r.method = std::move(method);
-  if (parsed.target) {
-    r.path = parsed.target->path;
-    r.query = parsed.target->query;
-    r.params = parsed.target->params;
-  }
-  return r;
-}
+using test::request;
 
 ServiceSnapshot snapshot_of(const std::string& actuator, double score, pipeline::AlarmState state) {
   ServiceSnapshot s;
