@@ -40,6 +40,10 @@ enum class EventKind {
   // the transducers' noise while it learns (pipeline/mode_visibility.hpp), so no leak alarm can
   // come from it. Announced when learning ends and again after a restart.
   detection_blind,
+  // When learning ends: the feature the detector learned made a step of alarm-worthy size
+  // during the learning period (detect/learned_change.hpp), so a leak may have been learned as
+  // healthy. `change_t` is when, `channel` and `feature` where, the leak or index fields the size.
+  learned_change,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -74,6 +78,8 @@ constexpr std::string_view to_string(EventKind kind) {
       return "relearning";
     case EventKind::detection_blind:
       return "detection_blind";
+    case EventKind::learned_change:
+      return "learned_change";
   }
   return "unknown";
 }
@@ -116,6 +122,10 @@ struct Event {
   // from when the detector decides again (learning done).
   double learning_since = kNoValue;
   double protected_from = kNoValue;
+  // learned_change: the estimated source time [s] of the step, and the feature it was seen in
+  // ("command_residual" or "index").
+  double change_t = kNoValue;
+  std::string feature;
 };
 
 // One actuator's newest decision as an output may publish it: its feature message, one JSON

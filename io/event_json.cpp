@@ -120,6 +120,8 @@ std::string to_json_line(const Event& event) {
   json.number("uptime_s", event.uptime_s);
   json.number("learning_since", event.learning_since);
   json.number("protected_from", event.protected_from);
+  json.number("change_t", event.change_t);
+  json.string("feature", event.feature);
   json.string("message", event.message);
   if (std::isfinite(event.unix_time)) {
     const auto seconds = static_cast<std::time_t>(event.unix_time);
