@@ -78,6 +78,12 @@ int run_replay(int argc, char** argv) {
       }
     }
   }
+  // A step during learning (detect/learned_change.hpp): the leak the events cannot show.
+  for (const auto& event : result.events) {
+    if (event.kind == io::EventKind::learned_change) {
+      fmt::print(stderr, "warning: {}\n", event.message);
+    }
+  }
   return 0;
 }
 

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 
 #include "detect/detector_state.hpp"
+#include "detect/learned_change.hpp"
 
 namespace leakmon::detect {
 
@@ -137,6 +139,10 @@ class Detector {
   // transducers' noise gives it nothing to see, and the daemon says so
   // (pipeline/mode_visibility.hpp).
   virtual bool needs_hydraulic_mode() const { return false; }
+  // Once learning is over: a step of alarm-worthy size the detector's own feature made while it
+  // learned (learned_change.hpp), which it has taken for healthy. Detectors that do not look
+  // return nothing; the actuator monitor probes the index of pressure-only ones itself.
+  virtual std::optional<LearnedChange> learned_change() const { return std::nullopt; }
 };
 
 }  // namespace leakmon::detect

@@ -56,6 +56,8 @@ FlowBalanceDetector::FlowBalanceDetector(const FlowBalanceOptions& options, doub
       drift_(drift_options(options, floor_slope_)) {
   learned_.reserve(clock_.learn_hops());
   scratch_.reserve(clock_.learn_hops());
+  // A kept block holds at least min_rest_hops_ of the learned hops.
+  probe_blocks_.reserve(clock_.learn_hops() / min_rest_hops_ + 1);
 }
 
 void FlowBalanceDetector::reset() {
@@ -65,6 +67,8 @@ void FlowBalanceDetector::reset() {
   before_ = pending_ = Hop{};
   last_ = Decision{};
   learned_.clear();
+  probe_blocks_.clear();
+  learned_change_.reset();
   coefficients_.setZero();
   positive_loads_ = negative_loads_ = LoadRange{};
   block_sigma_ = hop_sigma_ = kMissing;
@@ -246,7 +250,59 @@ void FlowBalanceDetector::finish_learning() {
     block_sigma_ = cusum_block_sigma(std::sqrt(sum_sq / static_cast<double>(blocks - 1)), blocks,
                                      lag_one_correlation(sum_lag, sum_sq));
   }
+  probe_learned_change();
   clock_.set_learned();
+}
+
+// The healthy relation once more, fitted to the reference share of the learning period only
+// (the load ranges and curvature terms stay those of the whole period); the residual blocks of
+// the whole period against it, screened like the detection's, go to find_slope_step. The
+// coefficients the detector keeps are not touched.
+void FlowBalanceDetector::probe_learned_change() {
+  learned_change_.reset();
+  probe_blocks_.clear();
+  if (learned_.empty()) return;
+  const double start = learned_.front().t;
+  const double split = start + kReferenceShare * (learned_.back().t - start);
+  LeastSquares<kTerms> fit;
+  for (const auto& rest : learned_) {
+    if (rest.t <= split) fit.add(healthy_terms(rest), rest.opening);
+  }
+  if (fit.count() < 2 * kTerms) return;
+  const Terms reference = fit.solve();
+  scratch_.clear();
+  for (const auto& rest : learned_) {
+    if (rest.t <= split)
+      scratch_.push_back(std::abs(rest.opening - reference.dot(healthy_terms(rest))));
+  }
+  const auto middle = scratch_.begin() + static_cast<std::ptrdiff_t>(scratch_.size() / 2);
+  std::nth_element(scratch_.begin(), middle, scratch_.end());
+  const double hop_sigma = 1.4826 * *middle;
+  std::size_t reference_blocks = 0;
+  for (std::size_t i = 0; i < learned_.size();) {
+    std::size_t j = i, kept = 0;
+    double residual_sum = 0.0, leak_term_sum = 0.0;
+    for (; j < learned_.size() && learned_[j].block == learned_[i].block; ++j) {
+      const double residual = learned_[j].opening - reference.dot(healthy_terms(learned_[j]));
+      // Off the flow branch (on_flow_branch, against the reference): a leak only ever needs
+      // more opening, so leaving these out cannot hide one.
+      if (-residual * sign_of(learned_[j].load) > kOffBranchSigmas * hop_sigma) continue;
+      residual_sum += residual;
+      leak_term_sum += learned_[j].leak_term;
+      ++kept;
+    }
+    if (kept >= min_rest_hops_) {
+      const double n = static_cast<double>(kept);
+      probe_blocks_.push_back(
+          {learned_[i].t, learned_[j - 1].t, residual_sum / n, leak_term_sum / n});
+      if (learned_[j - 1].t <= split) reference_blocks = probe_blocks_.size();
+    }
+    i = j;
+  }
+  SlopeStepOptions options;
+  options.floor_slope = std::max(floor_slope_, design_slope_);
+  options.slope_to_coefficient = options_.rig.Kv / std::sqrt(options_.rig.ps);
+  learned_change_ = find_slope_step(probe_blocks_, reference_blocks, options);
 }
 
 void FlowBalanceDetector::judge_block(double t, double mean_residual, double mean_leak_term) {

@@ -27,12 +27,14 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string_view>
 #include <vector>
 
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
 #include "detect/drift_reference.hpp"
+#include "detect/learned_change.hpp"
 #include "detect/learning_schedule.hpp"
 #include "detect/supply_tracker.hpp"
 #include "detect/valve_flow.hpp"
@@ -103,6 +105,7 @@ class FlowBalanceDetector final : public Detector {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
   }
   void resume_after_gap() override;
+  std::optional<LearnedChange> learned_change() const override { return learned_change_; }
 
   // The layout export_state() writes (legacy_state.hpp reads the ones before).
   static constexpr int kStateVersion = 4;
@@ -163,6 +166,8 @@ class FlowBalanceDetector final : public Detector {
   bool excited_enough();
   // The decision's judged state at source time t.
   void set_judged(Decision& decision, double t) const;
+  // The learned-change probe (learned_change.hpp) over the learning data, once it is complete.
+  void probe_learned_change();
   void judge_block(double t, double mean_residual, double mean_leak_term);
   double supply_for(const Observation& o, double speed);
   // Drift following (the healthy slope as a reference) only without a temperature.
@@ -214,6 +219,8 @@ class FlowBalanceDetector final : public Detector {
   bool temperature_seen_ = false;
   // The healthy slope on the leak term, followed without a temperature.
   DriftReference drift_;
+  std::vector<ResidualBlock> probe_blocks_;  // reserved at construction
+  std::optional<LearnedChange> learned_change_;
 };
 
 }  // namespace leakmon::detect

@@ -40,6 +40,14 @@ class FusedDetector final : public Detector {
                        [](const auto& member) { return member->needs_hydraulic_mode(); });
   }
 
+  // The first member's that found one.
+  std::optional<LearnedChange> learned_change() const override {
+    for (const auto& member : members_) {
+      if (auto change = member->learned_change()) return change;
+    }
+    return std::nullopt;
+  }
+
   // The latest decision of each member (same order as given), for diagnostics and evaluation.
   const std::vector<Decision>& member_decisions() const { return member_decisions_; }
   const std::vector<std::unique_ptr<Detector>>& members() const { return members_; }

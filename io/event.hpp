@@ -45,6 +45,10 @@ enum class EventKind {
   // the end of that.
   not_judged,
   judging_resumed,
+  // When learning ends: the feature the detector learned made a step of alarm-worthy size
+  // during the learning period (detect/learned_change.hpp), so a leak may have been learned as
+  // healthy. `change_t` is when, `channel` and `feature` where, the leak or index fields the size.
+  learned_change,
 };
 
 constexpr std::string_view to_string(EventKind kind) {
@@ -83,6 +87,8 @@ constexpr std::string_view to_string(EventKind kind) {
       return "not_judged";
     case EventKind::judging_resumed:
       return "judging_resumed";
+    case EventKind::learned_change:
+      return "learned_change";
   }
   return "unknown";
 }
@@ -127,6 +133,10 @@ struct Event {
   double protected_from = kNoValue;
   // not_judged / judging_resumed: source time [s] the detector stopped judging.
   double not_judged_since = kNoValue;
+  // learned_change: the estimated source time [s] of the step, and the feature it was seen in
+  // ("command_residual" or "index").
+  double change_t = kNoValue;
+  std::string feature;
 };
 
 // One actuator's newest decision as an output may publish it: its feature message, one JSON

@@ -121,6 +121,8 @@ std::string to_json_line(const Event& event) {
   json.number("learning_since", event.learning_since);
   json.number("protected_from", event.protected_from);
   json.number("not_judged_since", event.not_judged_since);
+  json.number("change_t", event.change_t);
+  json.string("feature", event.feature);
   json.string("message", event.message);
   if (std::isfinite(event.unix_time)) {
     const auto seconds = static_cast<std::time_t>(event.unix_time);

@@ -90,6 +90,12 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
     channels_.push_back(
         Channel{role, layout[role], detect::SensorPlausibility(config.transducers[role], rate)});
   }
+  if (watch_mode_) {
+    const double hop_s = static_cast<double>(config.features.step) / rate;
+    index_probes_.reserve(2);
+    index_probes_.emplace_back("p1", learning_seconds(), hop_s);
+    if (layout[Role::p2] >= 0) index_probes_.emplace_back("p2", learning_seconds(), hop_s);
+  }
 }
 
 AlarmSettings ActuatorMonitor::effective(const AlarmSettings& configured) const {
@@ -285,6 +291,44 @@ void ActuatorMonitor::judge_mode_visibility(double t, const detect::Observation&
   publish(event);
 }
 
+void ActuatorMonitor::judge_learned_change(double t, const EventPublisher& publish) {
+  std::optional<detect::LearnedChange> change = detector_->learned_change();
+  if (!change && probes_from_start_) {
+    for (const auto& probe : index_probes_) {
+      auto found = probe.judge();
+      if (found && (!change || found->z > change->z)) change = found;
+    }
+  }
+  for (auto& probe : index_probes_) probe.clear();
+  if (!change) return;
+  io::Event event;
+  event.kind = io::EventKind::learned_change;
+  event.t = t;
+  event.actuator = config_.name;
+  event.alarm = config_.alarm_name;
+  event.channel = std::string(change->channel);
+  event.feature = std::string(change->feature);
+  event.change_t = change->change_t;
+  std::string size;
+  if (change->feature == "index") {
+    event.baseline = change->reference;
+    event.index = change->reference - change->size;
+    size = fmt::format("the {} index fell from {:.1f} to {:.1f} kPa and stayed there",
+                       change->channel, change->reference / 1e3, event.index / 1e3);
+  } else {
+    event.leak_coefficient = change->size;
+    event.leak_lpm_per_mpa = units::lpm_per_mpa(change->size);
+    size = fmt::format("the valve command at rest rose as a leak of {:.3f} l/min/MPa would need",
+                       event.leak_lpm_per_mpa);
+  }
+  event.message = fmt::format(
+      "{}: learning may have included a leak at t={:.1f} s: {} ({:.0f} x its standard error), "
+      "and the {} detector learned that as healthy, so {} will not be raised for it. Check the "
+      "rig and let it learn again once it is known to be tight",
+      config_.name, change->change_t, size, change->z, detector_->name(), config_.alarm_name);
+  publish(event);
+}
+
 void ActuatorMonitor::check_sensor_faults(double t, bool outage, const EventPublisher& publish) {
   for (auto& channel : channels_) {
     const detect::SensorFault fault = channel.check.fault();
@@ -369,7 +413,14 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   }
   const bool was_learning = last_decision_.learning;
   last_decision_ = detector_->update(observation);
-  if (was_learning && !last_decision_.learning) learning_ended_t_ = t;
+  if (last_decision_.learning && !index_probes_.empty()) {
+    index_probes_[0].add(t, observation.index_p1);
+    if (index_probes_.size() > 1) index_probes_[1].add(t, observation.index_p2);
+  }
+  if (was_learning && !last_decision_.learning) {
+    learning_ended_t_ = t;
+    judge_learned_change(t, publish);
+  }
   last_load_pressure_ = std::abs(observation.p1 - observation.p2);
   ++decisions_;
   if (watch_mode_) judge_mode_visibility(t, observation, publish);
@@ -489,6 +540,8 @@ void ActuatorMonitor::import_state(const ActuatorState& state) {
     throw;
   }
   alarm_.restore(state.alarm, state.alarm_condition);
+  // The probes would see only the rest of the learning period: no reference to judge it by.
+  probes_from_start_ = false;
   detector_->resume_after_gap();
   detect::Observation gap;
   last_decision_ = detector_->update(gap);

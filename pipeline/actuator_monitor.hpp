@@ -169,6 +169,9 @@ class ActuatorMonitor {
   // announces a blind rig (and once more after a restart restored that verdict).
   void judge_mode_visibility(double t, const detect::Observation& observation,
                              const EventPublisher& publish);
+  // When learning has just ended: a step the learning period's feature made (the detector's own
+  // probe, or for a pressure-only detector the index probes here), announced as learned_change.
+  void judge_learned_change(double t, const EventPublisher& publish);
   bool detection_blind() const {
     return watch_mode_ &&
            (mode_out_of_band_ || healthy_index_ratio_ < ModeVisibilityCheck::kBlindRatio);
@@ -239,6 +242,10 @@ class ActuatorMonitor {
   double last_p1_ = io::kNoValue, last_p2_ = io::kNoValue;
   std::uint64_t decisions_ = 0;
   std::uint64_t gap_samples_ = 0;
+  // Pressure-only detectors: the learned-change probes of p1 (and p2), fed while learning; only
+  // judged when they saw the learning period from its start (not after a restored state).
+  std::vector<detect::IndexStepProbe> index_probes_;
+  bool probes_from_start_ = true;
   std::int64_t period_ns_;
   double newest_t_ = io::kNoValue;
   double protected_from_ = io::kNoValue;  // source time of the first decision (expected)

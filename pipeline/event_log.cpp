@@ -44,6 +44,8 @@ std::string to_log_line(const io::Event& event) {
   if (std::isfinite(event.not_judged_since)) {
     line += fmt::format(" not_judged_since={:.3f}s", event.not_judged_since);
   }
+  if (std::isfinite(event.change_t)) line += fmt::format(" change_t={:.3f}s", event.change_t);
+  if (!event.feature.empty()) line += fmt::format(" feature={}", event.feature);
   if (!event.message.empty()) line += fmt::format(": {}", event.message);
   // Event text can carry configuration and device content: no raw escape sequences in the log.
   return config::printable(line, 4000);
@@ -77,6 +79,7 @@ void LogEventSink::publish(const io::Event& event) {
       (event.kind == io::EventKind::alarm_raised || event.kind == io::EventKind::driver_fault ||
        event.kind == io::EventKind::overrun || event.kind == io::EventKind::config_rejected ||
        event.kind == io::EventKind::detection_blind || event.kind == io::EventKind::not_judged ||
+       event.kind == io::EventKind::learned_change ||
        event.kind == io::EventKind::state_discarded ||
        event.kind == io::EventKind::state_save_failed)
           ? spdlog::level::warn
