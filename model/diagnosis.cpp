@@ -382,13 +382,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   d.nrmse_before = predictor.nrmse(nominal.parameters, d.held_out_used);
   d.calibrated = nominal.parameters.calibration;
   d.extended = nominal.parameters;
-  // The ripple is named on its line test (only then is it a candidate at all), as long as its
-  // fit is physical and predicts the held-out data better (per segment and in NRMSE); any
-  // other effect on the held-out gain of the best plausible extension. An effect that gains
-  // more and is evidenced on its own comes first, though: the ripple then earns its place as
-  // a forward step like any other effect. A line that passed its test by chance, or a rig's
-  // own lightly damped hydraulic mode, gained nothing (score 0.001) and was named ahead of a
-  // leak scoring 0.99 (issue 24's evaluation, seed 732024; the paper's rig, seed 514079867).
+  // The ripple is a candidate only on its line test, and named first when its fit is physical
+  // and predicts the held-out data better with the same evidence as any effect (score and t):
+  // a rig's own lightly damped hydraulic mode, rung by the spool flow noise, passes the line
+  // test on other rigs, and a ripple fitted to it gained 0.0004 at t 0.4 and was named on a
+  // healthy rig (issue 24's evaluation, seed 732007). Any other effect on the held-out gain of
+  // the best plausible extension. An effect that gains more and is evidenced on its own comes
+  // first, though: the ripple then earns its place as a forward step like any other effect. A line
+  // that passed its test by chance, or a rig's own lightly damped hydraulic mode, gained nothing
+  // (score 0.001) and was named ahead of a leak scoring 0.99 (issue 24's evaluation, seed 732024;
+  // the paper's rig, seed 514079867).
   const auto evidenced = [&](const RankedEffect& r) {
     return r.plausible && r.refined && r.score >= settings.min_score &&
            r.significance >= settings.min_significance;
@@ -399,7 +402,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     const bool outranked = std::any_of(d.ranking.begin(), d.ranking.end(), [&](const auto& o) {
       return o.effect != "supply_ripple" && o.score > r.score && evidenced(o);
     });
-    if (r.effect == "supply_ripple" && r.plausible && r.refined && r.score > 0.0 && !outranked &&
+    if (r.effect == "supply_ripple" && evidenced(r) && !outranked &&
         predictor.nrmse(r.fit.parameters, d.held_out_used) < d.nrmse_before) {
       winner = &r;
       named = true;
@@ -412,6 +415,36 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       named = r.score >= settings.min_score && r.significance >= settings.min_significance;
       break;
     }
+  }
+  // Nothing named and the calibrated nominal model above its floor would be `unexplained`:
+  // before saying so, the calibration is tried from further starts across its bands (and with
+  // m free where the force balance fixed it). On other rigs the nominal fit's local minimum
+  // was sometimes well above the true model (a healthy 29 mm rig: 0.0265 against the true
+  // model's 0.0158 and a floor of 0.0138; issue 24's evaluation, seed 732015). A better
+  // minimum only lowers every effect's gain further, so the verdict on the effects stands;
+  // only `unexplained` against `none` depends on it.
+  if (!named && d.nrmse_before > settings.floor_factor * d.nrmse_floor) {
+    std::vector<std::pair<Calibration, FitSettings>> starts;
+    FitSettings all_free = fit_settings;
+    all_free.free_calibration = {true, true, true, true};
+    starts.emplace_back(stated_calibration, all_free);
+    for (const double beta : {0.8, 1.25}) {
+      for (const double kv : {0.92, 1.08}) {
+        Calibration c = catalogue;
+        c.beta *= beta;
+        c.Kv *= kv;
+        starts.emplace_back(within_bounds(c, stated_calibration), fit_settings);
+      }
+    }
+    for (const auto& [start, fs] : starts) {
+      FitResult retry = fit_model(predictor, d.fitting_used, nullptr, start, fs);
+      if (retry.cost < nominal.cost) nominal = std::move(retry);
+    }
+    d.nominal = nominal.parameters;
+    d.nrmse_before = predictor.nrmse(nominal.parameters, d.held_out_used);
+    d.calibrated = nominal.parameters.calibration;
+    d.extended = nominal.parameters;
+    d.nominal_at_bound = calibration_at_bound(nominal.parameters.calibration, stated_calibration);
   }
   // Forward selection: each further effect fitted jointly with the calibration and the causes
   // named so far, named only when it predicts the held-out data of that model better.
@@ -427,6 +460,45 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     d.steps.push_back({winner->effect, predictor.nrmse(current.parameters, d.held_out_used),
                        winner->score, winner->significance, true});
   }
+  // A named first cause whose model leaves a calibrated value on its bound and the held-out
+  // error above its floor's reach sits in a local minimum that the following steps would
+  // patch with further effects (issue 24's evaluation, seed 732002: the true external leak
+  // with Kv on its bound, then a supply droop and a transducer offset named next to it): it
+  // is refitted from starts across the calibration's bands first. Not an effect with an onset:
+  // until the onset search below its onset is the change point's, and a calibration refitted
+  // to that onset compensated for it (a dead band opening at 110 s, seed 762012, named alone
+  // without the retry, turned `unexplained` by the drift test with it).
+  if (named && chosen.front().onset_s <= 0.0 &&
+      !calibration_at_bound(current.parameters.calibration, stated_calibration).empty() &&
+      predictor.nrmse(current.parameters, d.held_out_used) >
+          settings.floor_factor * d.nrmse_floor) {
+    std::vector<Calibration> starts = {
+        within_bounds(current.parameters.calibration, stated_calibration)};
+    for (const double beta : {0.8, 1.25}) {
+      for (const double kv : {0.92, 1.08}) {
+        Calibration c = catalogue;
+        c.beta *= beta;
+        c.Kv *= kv;
+        starts.push_back(within_bounds(c, stated_calibration));
+      }
+    }
+    for (const auto& start : starts) {
+      FitResult retry = fit_model(predictor, d.fitting_used, &chosen.front(), start, fit_settings);
+      if (retry.cost < current.cost && chosen.front().plausible(retry.values)) {
+        current = std::move(retry);
+        for (std::size_t i = 0; i < current.values.size(); ++i) {
+          chosen.front().parameters[i].initial = current.values[i];
+        }
+      }
+    }
+  }
+  const auto adds_bound = [&](const Calibration& c) {
+    const auto before = calibration_at_bound(current.parameters.calibration, stated_calibration);
+    for (const auto& name : calibration_at_bound(c, stated_calibration)) {
+      if (std::find(before.begin(), before.end(), name) == before.end()) return true;
+    }
+    return false;
+  };
   while (named && chosen.size() < settings.max_causes) {
     const auto current_errors = segment_errors(predictor, current.parameters, d.held_out_used);
     double current_nrmse = predictor.nrmse(current.parameters, d.held_out_used);
@@ -470,6 +542,11 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       FitResult fit = fit_model(predictor, d.fitting_used, &joint, current.parameters.calibration,
                                 fit_settings);
       if (!joint.plausible(fit.values)) continue;
+      // A further effect that needs a calibrated value on its bound (twice MODEL.md's band
+      // around the stated value) where the model without it did not is trading with the
+      // calibration rather than explaining the data (a supply droop scales the valve's flow
+      // as Kv does, entrained air the stiffness as beta does).
+      if (adds_bound(fit.parameters.calibration)) continue;
       const auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
       SelectionStep step{
           name, predictor.nrmse(fit.parameters, d.held_out_used),

@@ -154,5 +154,56 @@ TEST(RippleLine, NeverNamedAheadOfAStrongerEffect) {
   EXPECT_NEAR(d.causes.front().params.front().value, c.main_value, 0.25 * c.main_value);
 }
 
+// A library effect hidden on another rig told its description is found, and found alone: no
+// second effect next to it, no rig_parameter. Three fresh rigs, one effect each among the
+// leak, the valve bias and the dead band (effects whose size is certain on any rig); the
+// evaluation named one library effect alone in 70-80 % of draws (docs/model-check.md), so
+// none of three alone happens about once in 100 runs.
+TEST(OtherRig, HiddenEffectIsNamedAlone) {
+  const auto seed = test::model_test_seed("OtherRig.HiddenEffectIsNamedAlone");
+  const char* effects[] = {"internal_leakage", "valve_bias", "valve_overlap"};
+  int alone = 0;
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    const SyntheticCase c = draw_case(seed + i, effects[i], other_rig(120.0));
+    const Diagnosis d = diagnose_case(c);
+    std::printf("  seed %llu: %s %s true %.4g\n", static_cast<unsigned long long>(seed + i),
+                effects[i], c.main_parameter.c_str(), c.main_value);
+    EXPECT_TRUE(d.rig_check.findings.empty()) << "seed " << seed + i;
+    if (d.causes.size() == 1 && d.causes.front().effect == effects[i] &&
+        std::abs(d.causes.front().params.front().value - c.main_value) <=
+            0.25 * std::abs(c.main_value)) {
+      ++alone;
+    }
+  }
+  EXPECT_GE(alone, 1);
+}
+
+// A healthy rig whose own lightly damped hydraulic mode, rung by the spool flow noise, shows
+// as a line in p1 + p2 that passes the ripple's line test: a fixed case of `model evaluate
+// --rigs other` (seed 732007, 180 s, the mode near 73 Hz, b 61 N s/m). The ripple fitted to
+// that line gained 0.0004 at t 0.4 and was named on its line test alone before the fix; now
+// it needs the held-out evidence of any effect. Fixed, not drawn: the line must pass for the
+// test to mean anything (asserted).
+TEST(RippleLine, AHealthyRigsOwnModeIsNoRipple) {
+  const SyntheticCase c = draw_case(732007, "none", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_TRUE(d.ripple_line_significant) << "the case no longer has a line: pick another";
+  for (const auto& cause : d.causes) EXPECT_NE(cause.effect, "supply_ripple") << causes(d);
+  EXPECT_EQ(d.cause, "none") << causes(d);
+}
+
+// A first cause whose model leaves a calibrated value on its bound is refitted from starts
+// across the calibration's bands before further effects are tried: a fixed case of `model
+// evaluate --rigs other` (seed 732002, 180 s: an 8.7e-13 external leak on a 4.5 kg rig),
+// named external_leakage + supply_droop + sensor_offset with Kv on its bound before the fix,
+// the leak alone after it.
+TEST(OtherRig, CalibrationOnItsBoundIsRefittedBeforeAnotherEffect) {
+  const SyntheticCase c = draw_case(732002, "external_leakage", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.causes.size(), 1u) << causes(d);
+  EXPECT_EQ(d.causes.front().effect, "external_leakage");
+  EXPECT_NEAR(d.causes.front().params.front().value, c.main_value, 0.25 * c.main_value);
+}
+
 }  // namespace
 }  // namespace leakmon::model
