@@ -183,6 +183,8 @@ class ActuatorMonitor {
   std::size_t hop_samples_ = 0;
   // The hop's cleaned chamber pressures (Observation::p1_samples), `step` long.
   std::vector<double> hop_samples_p1_, hop_samples_p2_;
+  // The hop's command and cleaned position the same way (Observation::u_samples, x_samples).
+  std::vector<double> hop_samples_u_, hop_samples_x_;
   // Ring of the excitation signal (xref, else x) over the window, for Observation::x_activity.
   std::vector<double> activity_;
   std::size_t activity_next_ = 0;
@@ -209,7 +211,7 @@ class ActuatorMonitor {
   bool mode_out_of_band_;
   bool mode_judged_ = false;
   double healthy_index_ratio_ = io::kNoValue;
-  bool announce_blind_ = false;  // a restored blind verdict, announced at the next decision
+  bool announce_blind_ = false;          // a restored blind verdict, announced at the next decision
   capture::ByRole<int> check_slot_{-1};  // by checked role, its index into channels_
   // u, xref and t delayed like the checked channels, so one sample stays one instant.
   struct Unchecked {
