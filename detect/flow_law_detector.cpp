@@ -214,8 +214,16 @@ bool FlowLawDetector::excited() const {
   double sum = 0.0, sum_sq = 0.0;
   for (const auto& b : learned_) sum += b.mean_load;
   const double mean = sum / static_cast<double>(learned_.size());
-  for (const auto& b : learned_) sum_sq += (b.mean_load - mean) * (b.mean_load - mean);
-  return std::sqrt(sum_sq / static_cast<double>(learned_.size() - 1)) >= options_.min_load_spread;
+  std::size_t away = 0;  // blocks whose load differs from the mean by the spread
+  for (const auto& b : learned_) {
+    sum_sq += (b.mean_load - mean) * (b.mean_load - mean);
+    if (std::abs(b.mean_load - mean) >= options_.min_load_spread) ++away;
+  }
+  // A long hold followed by a few blocks of motion has the spread but not the loads: a quarter
+  // of the blocks must be away from the mean, so that the model is not fitted to one load and
+  // extrapolated to all the others.
+  return std::sqrt(sum_sq / static_cast<double>(learned_.size() - 1)) >= options_.min_load_spread &&
+         4 * away >= learned_.size();
 }
 
 void FlowLawDetector::finish_learning() {
