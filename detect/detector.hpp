@@ -39,6 +39,9 @@ struct Observation {
   // oldest first, NaN where one was missing; empty when the chamber is not acquired), for
   // detectors that compute their own features. Valid only during the update() call.
   std::span<const double> p1_samples, p2_samples;
+  // The hop's command and position samples the same way (empty when not acquired), for
+  // detectors that integrate the flow balance in motion.
+  std::span<const double> u_samples, x_samples;
 };
 
 // Why a detector is not judging: it cannot see a leak right now, whatever the score says (the

@@ -9,6 +9,7 @@
 
 #include "detect/detail_xcorr_detector.hpp"
 #include "detect/flow_balance_detector.hpp"
+#include "detect/flow_law_detector.hpp"
 #include "detect/fused_detector.hpp"
 #include "detect/index_cusum_detector.hpp"
 #include "detect/option_table.hpp"
@@ -318,6 +319,83 @@ FlowBalanceOptions flow_options(const config::ConfigNode* node, double false_ala
   return o;
 }
 
+// ---- flow_law ----
+
+// The valve and piston rows of flow_balance's table, for any options with rig, design_leak and
+// min_leak (a leak of interest is a share of the valve's flow: the defaults scale with Kv).
+template <class O>
+std::vector<Option<O>> valve_options() {
+  return {number_option<O>("command_full_scale", 1e-3, 1e3, "valve command full scale [V]",
+                           [](O& o) -> double& { return o.rig.u_max; }),
+          other_option<O>(
+              "valve_coefficient", "", "", "nominal valve coefficient Kv [m^3/(s sqrt(Pa))]",
+              [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                if (node != nullptr) o.rig.Kv = node->get_double(row.key, o.rig.Kv, row.lo, row.hi);
+                const double valve_share = o.rig.Kv / sim::Parameters::nominal().Kv;
+                o.design_leak = O{}.design_leak * valve_share;
+                o.min_leak = O{}.min_leak * valve_share;
+              },
+              1e-12, 1.0, [](O& o) { return option_number_text(o.rig.Kv); }),
+          other_option<O>(
+              "piston_area", "", "", "piston area [m^2]; the default is the rig table's",
+              [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                double area = o.rig.A();
+                if (node != nullptr) area = node->get_double(row.key, area, row.lo, row.hi);
+                set_piston_area(o.rig, area);
+              },
+              1e-8, 10.0, [](O& o) { return option_number_text(o.rig.A()); })};
+}
+
+std::vector<Option<FlowLawOptions>> flow_law_rows() {
+  using O = FlowLawOptions;
+  return learning_options<O>() + supply_options<O>() + valve_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("spool_time_constant", 1e-5, 1.0,
+                              "the spool's first-order lag tau [s]",
+                              [](O& o) -> double& { return o.rig.tau; }),
+             number_option<O>("min_load_spread", 0.0, 1e9,
+                              "learning waits until the learning blocks' mean loads p1 - p2 "
+                              "spread this much (std) [Pa]",
+                              [](O& o) -> double& { return o.min_load_spread; }),
+             number_option<O>(
+                 "min_load", 0.0, 1e9,
+                 "a block whose mean load p1 - p2 is below this in size is not judged [Pa]",
+                 [](O& o) -> double& { return o.min_load; }),
+             number_option<O>("design_leak", 1e-16, 1e-8,
+                              "leak coefficient C_L the CUSUM is tuned for [m^3/(s Pa)]; the "
+                              "default scales with the rig's Kv / 3.39e-7",
+                              [](O& o) -> double& { return o.design_leak; })} +
+         false_alarm_options<O>() +
+         std::vector<Option<O>>{
+             number_option<O>("sizing_seconds", 1.0, kMaxOptionSeconds,
+                              "memory of the leak size estimate without a change [s]",
+                              [](O& o) -> double& { return o.sizing_seconds; }),
+             number_option<O>("min_leak", 0.0, 1e-8,
+                              "leak at 40 degC that is never an alarm [m^3/(s Pa)]; the default "
+                              "scales like design_leak's",
+                              [](O& o) -> double& { return o.min_leak; }),
+             number_option<O>("rest_speed", 1e-6, 10.0,
+                              "without `ps`: hops slower than this read the supply [m/s]",
+                              [](O& o) -> double& { return o.rest_speed; })} +
+         drift_options<O>(1.0) +
+         std::vector<Option<O>>{other_option<O>(
+             "estimate_supply", "", "true, false",
+             "without `ps`: the supply from the chambers at rest",
+             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+               if (node != nullptr) {
+                 o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
+               }
+             },
+             0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
+         oil_options<O>();
+}
+
+FlowLawOptions flow_law_options(const config::ConfigNode* node, const AvailableSignals&,
+                                const sim::RigDescription& rig) {
+  return read_checked<FlowLawOptions>(flow_law_rows(), on_rig(FlowLawOptions{}, rig), node,
+                                      nullptr);
+}
+
 // ---- detail_xcorr ----
 
 // design_shift / min_shift are in the feature's units: correlation with both chambers, ln of
@@ -452,6 +530,8 @@ std::vector<DetectorKind> detector_registry() {
        }},
       single_kind<DetailXcorrDetector, DetailXcorrOptions, xcorr_rows, xcorr_options>(
           "detail_xcorr", kPressure, has_pressure),
+      single_kind<FlowLawDetector, FlowLawOptions, flow_law_rows, flow_law_options>("flow_law",
+                                                                                    kAll, has_all),
   };
 }
 

@@ -69,6 +69,8 @@ ActuatorMonitor::ActuatorMonitor(const ActuatorConfig& config, const ChannelLayo
       fingerprint_(state_fingerprint(config, period_ns)),
       hop_samples_p1_(config.features.step, kNaN),
       hop_samples_p2_(config.features.step, kNaN),
+      hop_samples_u_(config.features.step, kNaN),
+      hop_samples_x_(config.features.step, kNaN),
       activity_(config.features.window, kNaN),
       index_input_(layout[Role::p2] >= 0 ? 2 : 1, kNaN),
       sample_rate_hz_(1e9 / static_cast<double>(period_ns)),
@@ -205,6 +207,8 @@ bool ActuatorMonitor::push(const realtime::Sample& sample, const EventPublisher&
   if (hop_samples_ < hop_samples_p1_.size()) {
     hop_samples_p1_[hop_samples_] = p1;
     hop_samples_p2_[hop_samples_] = p2;
+    hop_samples_u_[hop_samples_] = unchecked.u;
+    hop_samples_x_[hop_samples_] = x;
   }
   ++hop_samples_;
 
@@ -390,6 +394,8 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
   const std::size_t kept = std::min(hop_samples_, hop_samples_p1_.size());
   if (layout_[Role::p1] >= 0) observation.p1_samples = {hop_samples_p1_.data(), kept};
   if (layout_[Role::p2] >= 0) observation.p2_samples = {hop_samples_p2_.data(), kept};
+  if (layout_[Role::u] >= 0) observation.u_samples = {hop_samples_u_.data(), kept};
+  if (layout_[Role::x] >= 0) observation.x_samples = {hop_samples_x_.data(), kept};
   if ((layout_[Role::xref] >= 0 || layout_[Role::x] >= 0) && activity_filled_ == activity_.size()) {
     double sum = 0.0;
     for (double v : activity_) sum += v;

@@ -197,6 +197,8 @@ class ActuatorMonitor {
   std::size_t hop_samples_ = 0;
   // The hop's cleaned chamber pressures (Observation::p1_samples), `step` long.
   std::vector<double> hop_samples_p1_, hop_samples_p2_;
+  // The hop's command and cleaned position the same way (Observation::u_samples, x_samples).
+  std::vector<double> hop_samples_u_, hop_samples_x_;
   // Ring of the excitation signal (xref, else x) over the window, for Observation::x_activity.
   std::vector<double> activity_;
   std::size_t activity_next_ = 0;

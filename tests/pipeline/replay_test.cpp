@@ -119,3 +119,39 @@ TEST(Replay, TwoThreadsAtOnceGiveTheSameEventsAsOne) {
 
 }  // namespace
 }  // namespace leakmon::pipeline
+
+namespace leakmon::pipeline {
+namespace {
+
+// The flow balance in motion gets its per-sample command and position from the pipeline
+// (Observation::u_samples, x_samples): replayed, it learns on the steps and finds a leak that
+// opens during a sine, where the detectors that judge only at rest see nothing.
+TEST(Replay, FlowLawFindsALeakOpeningInASine) {
+  sim::Scenario scenario;
+  scenario.controller = sim::ControllerKind::fault_tolerant;
+  scenario.seed = 4;
+  scenario.duration_s = 180.0;
+  sim::Phase steps, sine;
+  steps.duration_s = 110.0;
+  sine.kind = sim::PhaseKind::sine;
+  sine.F = 1.5;
+  sine.A = 0.02;
+  scenario.program = {steps, sine};
+  sim::InternalLeakage leak;
+  leak.C_L = 1e-12;
+  leak.onset_s = 140.0;
+  scenario.effects.internal_leakage = leak;
+  const capture::Capture capture = sim::simulate(scenario);
+  DaemonConfig config = default_replay_config(capture);
+  config.actuators.at(0).detector = "flow_law";
+  const auto result = replay_capture(capture, config);
+  const auto alarms = raised(result);
+  ASSERT_EQ(alarms.size(), 1u);
+  EXPECT_GT(alarms[0].t, leak.onset_s);
+  EXPECT_LT(alarms[0].t, leak.onset_s + 10.0);
+  EXPECT_NEAR(alarms[0].leak_coefficient, 1e-12, 0.2e-12);
+  EXPECT_FALSE(result.actuators.at(0).learning);
+}
+
+}  // namespace
+}  // namespace leakmon::pipeline

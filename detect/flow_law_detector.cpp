@@ -1,0 +1,407 @@
+#include "detect/flow_law_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "detect/least_squares.hpp"
+#include "detect/legacy_state.hpp"
+#include "sim/spool.hpp"
+#include "sim/valve.hpp"
+
+namespace leakmon::detect {
+
+namespace {
+
+SupplyTrackerOptions supply_options(const FlowLawOptions& o, double hop_seconds) {
+  SupplyTrackerOptions s;
+  s.configured = o.rig.ps;
+  s.rule = SupplyTrackerOptions::StepRule::jump;
+  s.reading_seconds = hop_seconds;
+  return s;
+}
+
+// As flow_balance's: the reference is a slope on the load term, extrapolated at most by the floor.
+DriftReferenceOptions drift_options(const FlowLawOptions& o, double floor_slope) {
+  DriftReferenceOptions d;
+  d.guard_seconds = o.drift_guard_seconds;
+  d.window_seconds = o.drift_window_seconds;
+  d.keep_seconds = o.drift_guard_seconds + o.drift_window_seconds + o.block_seconds;
+  d.block_seconds = o.block_seconds;
+  d.bound = floor_slope;
+  return d;
+}
+
+// The leak's slope on the load regressor (int (p1 - p2) dt / ps, in units of Kv sqrt(ps) s).
+double slope_of(double leak, const sim::Parameters& rig) {
+  return leak * rig.ps / (rig.Kv * std::sqrt(rig.ps));
+}
+
+}  // namespace
+
+FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_seconds)
+    : options_(options),
+      hop_seconds_(hop_seconds),
+      block_hops_(hops_in(options.block_seconds, hop_seconds)),
+      flow_unit_(options.rig.Kv * std::sqrt(options.rig.ps)),
+      design_slope_(slope_of(options.design_leak, options.rig)),
+      floor_slope_(slope_of(options.min_leak, options.rig)),
+      sizing_decay_(std::exp(-options.block_seconds / options.sizing_seconds)),
+      clock_(options.learning, hop_seconds),
+      // Twice the learning period's blocks: while waiting for excitation the newest are kept.
+      learn_capacity_(2 * (clock_.learn_hops() / block_hops_ + 1)),
+      cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)),
+      supply_tracker_(supply_options(options, hop_seconds)),
+      drift_(drift_options(options, floor_slope_)) {
+  learned_.reserve(learn_capacity_);
+}
+
+void FlowLawDetector::reset() {
+  clock_.reset();
+  learned_.clear();
+  coefficients_.setZero();
+  block_sigma_ = kMissing;
+  waiting_ = false;
+  no_load_blocks_ = 0;
+  supply_ = viscosity_ratio_ = kMissing;
+  hop_usable_ = false;
+  previous_x_ = kMissing;
+  resume_after_gap();
+  weighted_ = since_change_ = SlopeSums{};
+  cusum_.reset();
+  supply_tracker_.reset();
+  temperature_seen_ = false;
+  drift_.clear();
+  last_ = Decision{};
+}
+
+// The samples before the gap are not neighbours of the next ones: the block in progress is lost.
+void FlowLawDetector::resume_after_gap() {
+  drift_.clear();
+  supply_tracker_.resume_after_gap();
+  previous_x_ = kMissing;
+  opening_ = previous_command_ = kMissing;
+  have_previous_ = false;
+  block_hop_ = 0;
+  block_ok_ = false;
+  sum_flow_ = sum_load_ = block_length_ = ratio_sum_ = 0.0;
+  ratio_hops_ = 0;
+}
+
+void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
+  if (std::isnan(u) || std::isnan(x) || std::isnan(p1) || std::isnan(p2)) {
+    block_ok_ = false;
+    have_previous_ = false;
+    return;
+  }
+  const sim::Parameters& rig = options_.rig;
+  // The spool lag, exact for a command held over each sample period (zero-order hold).
+  const double command = sim::spool_command(u, rig.u_max);
+  const double dt = sample_seconds_;
+  if (std::isnan(opening_)) {
+    opening_ = command;
+  } else {
+    const double keep = std::exp(-dt / rig.tau);
+    opening_ = keep * opening_ + (1.0 - keep) * previous_command_;
+  }
+  previous_command_ = command;
+  const sim::ValveFlows f =
+      sim::valve_flows(opening_, supply_, rig.pt, p1, p2, 1.0, rig.dp_lin, 0.0);
+  const double flow = 0.5 * (f.q1 - f.q2) / std::sqrt(rig.ps);  // in units of Kv sqrt(ps)
+  const double load = p1 - p2;
+  if (have_previous_) {
+    sum_flow_ += 0.5 * dt * (flow + previous_flow_);
+    sum_load_ += 0.5 * dt * (load + previous_load_);
+    block_length_ += dt;
+  } else {
+    start_x_ = x;
+    start_p1_ = p1;
+    start_p2_ = p2;
+  }
+  have_previous_ = true;
+  previous_flow_ = flow;
+  previous_load_ = load;
+  last_x_ = x;
+  last_p1_ = p1;
+  last_p2_ = p2;
+}
+
+Decision FlowLawDetector::update(const Observation& o) {
+  const double speed = (o.x - previous_x_) / hop_seconds_;
+  previous_x_ = o.x;
+  double reading = kMissing;
+  if (!std::isnan(o.ps)) {
+    reading = o.ps;
+  } else if (options_.estimate_supply && !std::isnan(o.p1) && !std::isnan(o.p2) &&
+             std::abs(speed) < options_.rest_speed) {
+    reading = o.p1 + o.p2 - options_.rig.pt;  // at rest the lands balance (MODEL.md)
+  }
+  supply_tracker_.add(o.t, reading, !std::isnan(o.ps));
+  supply_ = supply_tracker_.estimate();
+  if (!std::isnan(o.temp)) temperature_seen_ = true;
+  hop_usable_ = !temperature_seen_ || !std::isnan(o.temp);
+  if (!hop_usable_) block_ok_ = false;
+  if (!std::isnan(o.temp)) {
+    viscosity_ratio_ = options_.oil.ratio(o.temp);
+    ratio_sum_ += viscosity_ratio_;
+    ++ratio_hops_;
+  } else {
+    viscosity_ratio_ = kMissing;
+  }
+  const std::size_t n = o.u_samples.size();
+  if (n == 0 || o.x_samples.size() != n || o.p1_samples.size() != n || o.p2_samples.size() != n) {
+    block_ok_ = false;
+    have_previous_ = false;
+  } else {
+    sample_seconds_ = hop_seconds_ / static_cast<double>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      add_sample(o.u_samples[i], o.x_samples[i], o.p1_samples[i], o.p2_samples[i]);
+    }
+  }
+  const bool past_settling = clock_.count_hop();
+  if (++block_hop_ >= block_hops_) close_block(o.t, past_settling);
+  last_ = decide();
+  return last_;
+}
+
+void FlowLawDetector::close_block(double t, bool past_settling) {
+  const sim::Parameters& rig = options_.rig;
+  const bool ok = block_ok_ && have_previous_ && block_length_ > 0.0 &&
+                  supply_tracker_.settled(t) && past_settling;
+  Block b;
+  if (ok) {
+    const double area = rig.A(), v0 = rig.V0();
+    const double ratio =
+        temperature_seen_ && ratio_hops_ > 0 ? ratio_sum_ / static_cast<double>(ratio_hops_) : 1.0;
+    b.t = t;
+    b.y = sum_flow_;
+    b.move = area * (last_x_ - start_x_) / flow_unit_;
+    b.load = sum_load_ / rig.ps * ratio;
+    const double v1e = v0 + area * last_x_, v2e = v0 - area * last_x_;
+    const double v1s = v0 + area * start_x_, v2s = v0 - area * start_x_;
+    b.comp = 0.5 * ((v1e * last_p1_ - v1s * start_p1_) - (v2e * last_p2_ - v2s * start_p2_)) /
+             (sim::Parameters::nominal().beta * flow_unit_);
+    b.length = block_length_;
+    b.mean_load = sum_load_ / block_length_;
+  }
+  block_hop_ = 0;
+  block_ok_ = have_previous_ && hop_usable_;
+  start_x_ = last_x_;
+  start_p1_ = last_p1_;
+  start_p2_ = last_p2_;
+  sum_flow_ = sum_load_ = block_length_ = ratio_sum_ = 0.0;
+  ratio_hops_ = 0;
+  if (!ok) return;
+  if (!clock_.learned()) {
+    learn(b);
+  } else {
+    judge(b);
+  }
+}
+
+void FlowLawDetector::learn(const Block& b) {
+  if (learned_.size() == learn_capacity_) learned_.erase(learned_.begin());
+  learned_.push_back(b);
+  if (!clock_.period_over()) return;
+  waiting_ = !excited();
+  if (!waiting_) finish_learning();
+}
+
+// The cross-port term is identifiable only with several loads: a hold alone makes it collinear
+// with the offset.
+bool FlowLawDetector::excited() const {
+  if (learned_.size() < 20) return false;
+  double sum = 0.0, sum_sq = 0.0;
+  for (const auto& b : learned_) sum += b.mean_load;
+  const double mean = sum / static_cast<double>(learned_.size());
+  std::size_t away = 0;  // blocks whose load differs from the mean by the spread
+  for (const auto& b : learned_) {
+    sum_sq += (b.mean_load - mean) * (b.mean_load - mean);
+    if (std::abs(b.mean_load - mean) >= options_.min_load_spread) ++away;
+  }
+  // A long hold followed by a few blocks of motion has the spread but not the loads: a quarter
+  // of the blocks must be away from the mean, so that the model is not fitted to one load and
+  // extrapolated to all the others.
+  return std::sqrt(sum_sq / static_cast<double>(learned_.size() - 1)) >= options_.min_load_spread &&
+         4 * away >= learned_.size();
+}
+
+void FlowLawDetector::finish_learning() {
+  LeastSquares<4> fit;
+  for (const auto& b : learned_) fit.add(regressors(b), b.y);
+  coefficients_ = fit.solve();
+  double sum_sq = 0.0, sum_lag = 0.0, previous = 0.0;
+  double previous_t = kMissing;
+  for (const auto& b : learned_) {
+    const double r = residual(b);
+    sum_sq += r * r;
+    // Neighbours only (the next block after the previous one).
+    if (std::abs(b.t - previous_t - options_.block_seconds) < 0.5 * options_.block_seconds) {
+      sum_lag += r * previous;
+    }
+    previous = r;
+    previous_t = b.t;
+    drift_.add(b.t, r, b.load);
+  }
+  const std::size_t blocks = learned_.size();
+  const double dof = static_cast<double>(blocks > 4 ? blocks - 4 : 1);
+  block_sigma_ = cusum_block_sigma(std::sqrt(sum_sq / dof), blocks,
+                                   sum_sq > 0.0 ? lag_one_correlation(sum_lag, sum_sq) : 0.0);
+  clock_.set_learned();
+  learned_.clear();
+}
+
+void FlowLawDetector::judge(const Block& b) {
+  if (!(block_sigma_ > 0.0)) return;
+  if (std::abs(b.mean_load) < options_.min_load) {
+    ++no_load_blocks_;  // not judged: no_load
+    return;
+  }
+  // As flow_balance: the log-likelihood ratio of "the designed leak" against "the floor", the
+  // shift capped and the residual winsorised so that one odd block cannot raise.
+  constexpr double kMaxShift = 3.0, kMaxZ = 4.0;
+  const double a = coefficients_[0];
+  const double r = residual(b);
+  const double reference =
+      temperature_seen_ ? 0.0 : drift_.reference(b.t, block_sigma_, false, kMissing);
+  const double excess = r - reference * b.load;
+  const double shift = std::clamp(a * design_slope_ * b.load / block_sigma_, -kMaxShift, kMaxShift);
+  const double floor = a * floor_slope_ * b.load / block_sigma_;
+  const double z = std::clamp(excess / block_sigma_ - floor, -kMaxZ, kMaxZ);
+  const bool was_quiet = cusum_.value() <= 0.0;
+  cusum_.add(b.t, shift * (z - shift / 2.0));
+  if (!temperature_seen_ && cusum_.normalised() < 0.5) drift_.add(b.t, r, b.load);
+  const double rl = excess * b.load, ll = b.load * b.load;
+  weighted_.rl = sizing_decay_ * weighted_.rl + rl;
+  weighted_.ll = sizing_decay_ * weighted_.ll + ll;
+  if (was_quiet) since_change_ = SlopeSums{};
+  if (cusum_.value() > 0.0) {
+    since_change_.rl += rl;
+    since_change_.ll += ll;
+  }
+}
+
+Decision FlowLawDetector::decide() const {
+  Decision d;
+  if (!clock_.learned()) {
+    d.learning_hops_left = waiting_ ? kMissing : clock_.hops_left();
+    return d;
+  }
+  d.learning = false;
+  d.viscosity_ratio = viscosity_ratio_;
+  if (!(block_sigma_ > 0.0)) return d;
+  d.score = cusum_.normalised();
+  // Sized from the blocks since the CUSUM left zero only once it is suspicious: a CUSUM that
+  // only just left zero holds a block or two, too few to size anything.
+  const SlopeSums& sums =
+      cusum_.normalised() >= 0.5 && since_change_.ll > 0.0 ? since_change_ : weighted_;
+  if (sums.ll > 0.0) {
+    const double a = coefficients_[0];
+    const double to_leak = flow_unit_ / options_.rig.ps / a;
+    d.leak_coefficient = sums.rl / sums.ll * to_leak;
+    d.leak_coefficient_ci = 1.96 * block_sigma_ / std::sqrt(sums.ll) * std::abs(to_leak);
+  }
+  return d;
+}
+
+namespace {
+constexpr std::array<std::string_view, 4> kCoefficientNames = {"move", "load", "comp", "length"};
+}
+
+DetectorState FlowLawDetector::export_state() const {
+  DetectorState state(std::string(name()), kStateVersion);
+  clock_.save(state, "learning");
+  put_records(state, "learned", std::span<const Block>(learned_), block_fields());
+  for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
+    state.put(state_key("coefficient", kCoefficientNames[i]),
+              coefficients_[static_cast<Eigen::Index>(i)]);
+  }
+  state.put("block_sigma", block_sigma_);
+  state.put("waiting", waiting_ ? 1.0 : 0.0);
+  state.put_count("no_load_blocks", no_load_blocks_);
+  state.put("supply", supply_);
+  state.put("viscosity_ratio", viscosity_ratio_);
+  state.put("hop_usable", hop_usable_ ? 1.0 : 0.0);
+  state.put("previous_x", previous_x_);
+  state.put("sample_seconds", sample_seconds_);
+  state.put("spool.opening", opening_);
+  state.put("spool.previous_command", previous_command_);
+  state.put("sample.have_previous", have_previous_ ? 1.0 : 0.0);
+  state.put("sample.flow", previous_flow_);
+  state.put("sample.load", previous_load_);
+  state.put("sample.x", last_x_);
+  state.put("sample.p1", last_p1_);
+  state.put("sample.p2", last_p2_);
+  state.put_count("block.hops", block_hop_);
+  state.put("block.ok", block_ok_ ? 1.0 : 0.0);
+  state.put("block.start_x", start_x_);
+  state.put("block.start_p1", start_p1_);
+  state.put("block.start_p2", start_p2_);
+  state.put("block.flow", sum_flow_);
+  state.put("block.load", sum_load_);
+  state.put("block.length", block_length_);
+  state.put("block.ratio_sum", ratio_sum_);
+  state.put_count("block.ratio_hops", ratio_hops_);
+  state.put("sizing.weighted.rl", weighted_.rl);
+  state.put("sizing.weighted.ll", weighted_.ll);
+  state.put("sizing.since_change.rl", since_change_.rl);
+  state.put("sizing.since_change.ll", since_change_.ll);
+  cusum_.save(state, "cusum");
+  supply_tracker_.save(state, "supply_tracker");
+  state.put("temperature_seen", temperature_seen_ ? 1.0 : 0.0);
+  drift_.save(state, "drift");
+  return state;
+}
+
+void FlowLawDetector::import_state(const DetectorState& saved) {
+  import_detector_state(*this, saved, kStateVersion, [this](const DetectorState& state) {
+    clock_.restore(state, "learning");
+    const std::size_t learned = record_count(state, "learned", block_fields());
+    if (learned > learned_.capacity()) {
+      throw StateError("learned blocks do not fit this configuration");
+    }
+    learned_.resize(learned);  // within the reserved capacity
+    get_records(state, "learned", block_fields(), std::span<Block>(learned_));
+    for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
+      coefficients_[static_cast<Eigen::Index>(i)] =
+          state.get(state_key("coefficient", kCoefficientNames[i]));
+    }
+    block_sigma_ = state.get("block_sigma");
+    waiting_ = state.get("waiting") != 0.0;
+    no_load_blocks_ = state.get_count("no_load_blocks");
+    supply_ = state.get("supply");
+    viscosity_ratio_ = state.get("viscosity_ratio");
+    hop_usable_ = state.get("hop_usable") != 0.0;
+    previous_x_ = state.get("previous_x");
+    sample_seconds_ = state.get("sample_seconds");
+    opening_ = state.get("spool.opening");
+    previous_command_ = state.get("spool.previous_command");
+    have_previous_ = state.get("sample.have_previous") != 0.0;
+    previous_flow_ = state.get("sample.flow");
+    previous_load_ = state.get("sample.load");
+    last_x_ = state.get("sample.x");
+    last_p1_ = state.get("sample.p1");
+    last_p2_ = state.get("sample.p2");
+    block_hop_ = state.get_count("block.hops");
+    if (block_hop_ >= block_hops_) throw StateError("block position out of range");
+    block_ok_ = state.get("block.ok") != 0.0;
+    start_x_ = state.get("block.start_x");
+    start_p1_ = state.get("block.start_p1");
+    start_p2_ = state.get("block.start_p2");
+    sum_flow_ = state.get("block.flow");
+    sum_load_ = state.get("block.load");
+    block_length_ = state.get("block.length");
+    ratio_sum_ = state.get("block.ratio_sum");
+    ratio_hops_ = state.get_count("block.ratio_hops");
+    weighted_ = SlopeSums{state.get("sizing.weighted.rl"), state.get("sizing.weighted.ll")};
+    since_change_ =
+        SlopeSums{state.get("sizing.since_change.rl"), state.get("sizing.since_change.ll")};
+    cusum_.restore(state, "cusum");
+    supply_tracker_.restore(state, "supply_tracker");
+    temperature_seen_ = state.get("temperature_seen") != 0.0;
+    drift_.restore(state, "drift");
+    last_ = decide();
+  });
+}
+
+}  // namespace leakmon::detect

@@ -1,0 +1,156 @@
+// Flow balance in motion (issue #23): judges the valve's flow balance in every test program, not
+// only at rest. Over each block of `block_seconds` the load flow the valve delivers by its
+// orifice law (MODEL.md "Nominal model": the spool's first-order lag of sat(u / u_max), the
+// rig's Kv, ps, pt, dp_lin) is integrated sample by sample (trapezoid, no differentiation of the
+// noisy position) and regressed on what the piston must take:
+//   Y = int qL dt ~ a A (x_end - x_start) + c int (p1 - p2) dt
+//                   + k [(V1 p1) - (V2 p2)]_start^end / 2 + d T.
+// a absorbs Kv's error (a = Kv_nominal / Kv_true), k ~ 1 / beta, c is the healthy cross-port
+// term (the valve's null leakage) times a, d a constant flow offset. They are learned by least
+// squares over the learning period; a single load (a hold alone) makes the cross-port term
+// collinear with the offset, so learning waits for a spread of block loads
+// (`min_load_spread`). Then a cross-piston leak C_L adds a C_L int (p1 - p2) dt to the residual:
+// a block CUSUM tuned for `design_leak` tests it, with `min_leak` as the floor (as flow_balance).
+// A block whose mean |p1 - p2| stays below `min_load` carries no information and is not judged.
+// Laminar paths follow viscosity: with a `temp` observation the load term is scaled to 40 degC;
+// without, the healthy slope is followed by the shared drift reference behind a guard.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "detect/cusum.hpp"
+#include "detect/detector.hpp"
+#include "detect/drift_reference.hpp"
+#include "detect/learning_schedule.hpp"
+#include "detect/supply_tracker.hpp"
+#include "sim/oil.hpp"
+#include "sim/parameters.hpp"
+
+namespace leakmon::detect {
+
+struct FlowLawOptions {
+  LearningSchedule learning{2.0, 120.0};
+  // The rig table: ps, pt, u_max, dp_lin, tau, Kv, the piston area A() and V0() are used.
+  sim::Parameters rig;
+  double block_seconds = 0.2;
+  // Learning finishes only when the block-mean loads p1 - p2 of the learning blocks spread at
+  // least this much (standard deviation) [Pa].
+  double min_load_spread = 0.3e6;
+  // A block with |mean p1 - p2| below this is not judged (no load, no leak flow) [Pa].
+  double min_load = 0.3e6;
+  // Scaled by the factory with Kv / 3.39e-7, as flow_balance's.
+  double design_leak = 5e-13;
+  double min_leak = 2.5e-13;
+  double false_alarms_per_hour = 0.05;
+  double sizing_seconds = 60.0;
+  sim::Oil oil = sim::Oil::standard();
+  double drift_guard_seconds = 30.0;
+  double drift_window_seconds = 120.0;
+  double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers
+  bool estimate_supply = true;
+};
+
+class FlowLawDetector final : public Detector {
+ public:
+  FlowLawDetector(const FlowLawOptions& options, double hop_seconds);
+
+  std::string_view name() const override { return "flow_law"; }
+  Decision update(const Observation& observation) override;
+  double raise_threshold() const override { return 1.0; }
+  double clear_threshold() const override { return 0.5; }
+  void reset() override;
+  DetectorState export_state() const override;
+  void import_state(const DetectorState& state) override;
+  void resume_after_gap() override;
+  double learning_seconds() const override {
+    return options_.learning.settle_seconds + options_.learning.learn_seconds;
+  }
+  // The learning period is over but the loads seen so far do not identify the model (a hold
+  // alone): waiting for excitation.
+  bool waiting_for_excitation() const { return waiting_; }
+  // The learned coefficients [a, c, k, d] in normalised units (a = Kv_nominal / Kv_true).
+  Eigen::Vector4d coefficients() const { return coefficients_; }
+  std::size_t blocks_not_judged_no_load() const { return no_load_blocks_; }
+
+  static constexpr int kStateVersion = 1;
+
+ private:
+  // One closed block, regressors in units of the valve's full flow Kv sqrt(ps) times seconds.
+  struct Block {
+    double t = kMissing;
+    double y = kMissing;          // int qL dt
+    double move = kMissing;       // A dx
+    double load = kMissing;       // int (p1 - p2) dt / ps (times the viscosity ratio with temp)
+    double comp = kMissing;       // compressibility term / beta_nominal
+    double length = kMissing;     // T
+    double mean_load = kMissing;  // mean p1 - p2 [Pa]
+  };
+  static constexpr std::array<RecordField<Block>, 7> block_fields() {
+    return {record_field<&Block::t>("t"),
+            record_field<&Block::y>("y"),
+            record_field<&Block::move>("move"),
+            record_field<&Block::load>("load"),
+            record_field<&Block::comp>("comp"),
+            record_field<&Block::length>("length"),
+            record_field<&Block::mean_load>("mean_load")};
+  }
+  static Eigen::Vector4d regressors(const Block& b) { return {b.move, b.load, b.comp, b.length}; }
+  double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
+
+  void add_sample(double u, double x, double p1, double p2);
+  void close_block(double t, bool past_settling);
+  void learn(const Block& b);
+  bool excited() const;
+  void finish_learning();
+  void judge(const Block& b);
+  Decision decide() const;
+
+  FlowLawOptions options_;
+  double hop_seconds_;
+  std::size_t block_hops_;
+  double flow_unit_;     // Kv sqrt(ps) [m^3/s]
+  double design_slope_;  // design_leak in the load regressor's units (before a)
+  double floor_slope_;
+  double sizing_decay_;
+  LearningClock clock_;
+  std::vector<Block> learned_;  // reserved at construction; the newest when waiting
+  std::size_t learn_capacity_;
+  Eigen::Vector4d coefficients_ = Eigen::Vector4d::Zero();
+  double block_sigma_ = kMissing;
+  bool waiting_ = false;
+  std::size_t no_load_blocks_ = 0;
+  // Per hop.
+  double supply_ = kMissing;  // supply used this hop [Pa]
+  double viscosity_ratio_ = kMissing;
+  bool hop_usable_ = false;
+  double sample_seconds_ = kMissing;
+  double previous_x_ = kMissing;  // hop mean, for the rest test of the supply estimate
+  // Per sample: the spool (exact zero-order-hold lag) and the previous sample.
+  double opening_ = kMissing, previous_command_ = kMissing;
+  bool have_previous_ = false;
+  double previous_flow_ = 0.0, previous_load_ = 0.0;
+  double last_x_ = 0.0, last_p1_ = 0.0, last_p2_ = 0.0;
+  // The current block.
+  std::size_t block_hop_ = 0;
+  bool block_ok_ = false;
+  double start_x_ = 0.0, start_p1_ = 0.0, start_p2_ = 0.0;
+  double sum_flow_ = 0.0, sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
+  std::size_t ratio_hops_ = 0;
+  // The added slope on the load term: exponentially weighted, and since the CUSUM left zero.
+  struct SlopeSums {
+    double rl = 0.0, ll = 0.0;
+  };
+  SlopeSums weighted_, since_change_;
+  BlockCusum cusum_;
+  SupplyTracker supply_tracker_;
+  bool temperature_seen_ = false;
+  DriftReference drift_;
+  Decision last_;
+};
+
+}  // namespace leakmon::detect
