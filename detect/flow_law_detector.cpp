@@ -159,6 +159,7 @@ Decision FlowLawDetector::update(const Observation& o) {
     }
   }
   const bool past_settling = clock_.count_hop();
+  last_t_ = o.t;
   if (++block_hop_ >= block_hops_) close_block(o.t, past_settling);
   last_ = decide();
   return last_;
@@ -191,7 +192,11 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
   start_p2_ = last_p2_;
   sum_flow_ = sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
-  if (!ok) return;
+  if (!ok) {
+    block_reason_ =
+        !supply_tracker_.settled(t) ? NotJudgedReason::supply_settling : NotJudgedReason::data_gap;
+    return;
+  }
   if (!clock_.learned()) {
     learn(b);
   } else {
@@ -254,9 +259,11 @@ void FlowLawDetector::finish_learning() {
 void FlowLawDetector::judge(const Block& b) {
   if (!(block_sigma_ > 0.0)) return;
   if (std::abs(b.mean_load) < options_.min_load) {
-    ++no_load_blocks_;  // not judged: no_load
+    ++no_load_blocks_;
+    block_reason_ = NotJudgedReason::no_load;
     return;
   }
+  last_judged_t_ = b.t;
   // As flow_balance: the log-likelihood ratio of "the designed leak" against "the floor", the
   // shift capped and the residual winsorised so that one odd block cannot raise.
   constexpr double kMaxShift = 3.0, kMaxZ = 4.0;
@@ -285,12 +292,19 @@ Decision FlowLawDetector::decide() const {
   Decision d;
   if (!clock_.learned()) {
     d.learning_hops_left = waiting_ ? kMissing : clock_.hops_left();
+    d.not_judged_reason =
+        waiting_ ? NotJudgedReason::waiting_for_excitation : NotJudgedReason::learning;
     return d;
   }
   d.learning = false;
   d.viscosity_ratio = viscosity_ratio_;
-  if (!(block_sigma_ > 0.0)) return d;
+  if (!(block_sigma_ > 0.0)) {
+    d.not_judged_reason = NotJudgedReason::cannot_learn;
+    return d;
+  }
   d.score = cusum_.normalised();
+  d.judged = last_t_ - last_judged_t_ <= options_.judged_memory_seconds;  // false when NaN
+  d.not_judged_reason = d.judged ? NotJudgedReason::none : block_reason_;
   // Sized from the blocks since the CUSUM left zero only once it is suspicious: a CUSUM that
   // only just left zero holds a block or two, too few to size anything.
   const SlopeSums& sums =

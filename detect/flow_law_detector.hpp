@@ -53,6 +53,8 @@ struct FlowLawOptions {
   double drift_window_seconds = 120.0;
   double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers
   bool estimate_supply = true;
+  // A decision counts as judged while a block was judged within this time [s] (status, metrics).
+  double judged_memory_seconds = 10.0;
 };
 
 class FlowLawDetector final : public Detector {
@@ -124,6 +126,10 @@ class FlowLawDetector final : public Detector {
   double block_sigma_ = kMissing;
   bool waiting_ = false;
   std::size_t no_load_blocks_ = 0;
+  // What the status says: when a block was last judged, and why the latest one was not.
+  double last_judged_t_ = kMissing;
+  double last_t_ = kMissing;
+  NotJudgedReason block_reason_ = NotJudgedReason::learning;
   // Per hop.
   double supply_ = kMissing;  // supply used this hop [Pa]
   double viscosity_ratio_ = kMissing;

@@ -158,10 +158,38 @@ TEST(FlowLaw, HoldOnlyStartWaitsForExcitation) {
   EXPECT_TRUE(detector.waiting_for_excitation());
   EXPECT_TRUE(hold.last.learning);
   EXPECT_TRUE(std::isnan(hold.last.learning_hops_left));
+  EXPECT_FALSE(hold.last.judged);
+  EXPECT_EQ(hold.last.not_judged_reason, NotJudgedReason::waiting_for_excitation);
   const Outcome steps = run(detector, capture, 1e9, hold_end);
   EXPECT_GT(steps.learned_at, 60.0);
   EXPECT_FALSE(detector.waiting_for_excitation());
   EXPECT_FALSE(steps.last.learning);
+  EXPECT_TRUE(steps.last.judged);
+  EXPECT_EQ(steps.last.not_judged_reason, NotJudgedReason::none);
+}
+
+// After learning, a hold at the spring's rest position leaves no leak flow to judge: the
+// decision says so (no_load) once the last judged block is older than judged_memory_seconds,
+// and judges again when the load comes back.
+TEST(FlowLaw, HoldAtTheSpringsRestIsSaidAsNotJudged) {
+  std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 130.0),
+                                    phase(sim::PhaseKind::hold, 40.0),
+                                    phase(sim::PhaseKind::sine, 0.0)};
+  phases[1].X = 0.0;
+  phases[2].F = 0.5;
+  phases[2].A = 0.02;
+  const capture::Capture capture = sim::simulate(program(7, phases, 200.0));
+  FlowLawDetector detector = make();
+  const std::size_t hold_end = static_cast<std::size_t>(170.0 * 500.0);
+  const Outcome to_hold = run(detector, capture, 1e9, 0, hold_end);
+  EXPECT_FALSE(to_hold.last.learning);
+  EXPECT_FALSE(to_hold.last.judged);
+  EXPECT_EQ(to_hold.last.not_judged_reason, NotJudgedReason::no_load);
+  EXPECT_LT(to_hold.max_score, detector.raise_threshold());
+  const Outcome sine = run(detector, capture, 1e9, hold_end);
+  EXPECT_TRUE(sine.last.judged);
+  EXPECT_EQ(sine.last.not_judged_reason, NotJudgedReason::none);
+  EXPECT_LT(sine.max_score, detector.raise_threshold());
 }
 
 // A detector restored from another's state mid-run (mid-block) decides as that one would.
