@@ -247,7 +247,11 @@ TEST(MqttBroker, AnAbsentOrSilentBrokerNeverStallsTheDaemon) {
       << daemon.log();
   std::this_thread::sleep_for(1s);
   const std::string cycles = "leakmon_loop_cycles_total{group=\"main\"}";
+  const std::string overruns = "leakmon_loop_overruns_total{group=\"main\"}";
+  const std::string missed = "leakmon_loop_missed_cycles_total{group=\"main\"}";
   const double cycles_before = metric(metrics_port, cycles);
+  const double overruns_before = metric(metrics_port, overruns);
+  const double missed_before = metric(metrics_port, missed);
   const double processed_before = metric(metrics_port, "leakmon_samples_processed_total");
   reload_times(daemon, 3);
   std::this_thread::sleep_for(2s);
@@ -257,7 +261,10 @@ TEST(MqttBroker, AnAbsentOrSilentBrokerNeverStallsTheDaemon) {
   EXPECT_GT(cycles_after - cycles_before, 150.0);
   EXPECT_GT(processed_after - processed_before, 0.9 * (cycles_after - cycles_before));
   EXPECT_EQ(metric(metrics_port, "leakmon_ring_drops_total{group=\"main\"}"), 0.0);
-  EXPECT_EQ(metric(metrics_port, "leakmon_loop_overruns_total{group=\"main\"}"), 0.0);
+  // A connect that blocked the loop for the broker's 1 s timeout would miss about 100 periods of
+  // 10 ms; a late wake-up or two on a loaded machine (a sanitizer build) is not a stall.
+  EXPECT_LE(metric(metrics_port, overruns) - overruns_before, 2.0);
+  EXPECT_LE(metric(metrics_port, missed) - missed_before, 2.0);
   for (const std::string output : {"silent", "absent"}) {
     const std::string label = "{output=\"" + output + "\"}";
     EXPECT_EQ(metric(metrics_port, "leakmon_mqtt_connected" + label), 0.0);
