@@ -217,6 +217,17 @@ void set_piston_area(sim::Parameters& rig, double area) {
   rig.D = std::sqrt(4.0 * area / std::numbers::pi + rig.d * rig.d);
 }
 
+// The flow balances' supply from the chambers at rest when there is no `ps` (both detectors).
+template <typename O>
+std::vector<Option<O>> estimate_supply_options() {
+  return {other_option<O>(
+      "estimate_supply", "", "true, false", "without `ps`: the supply from the chambers at rest",
+      [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+        if (node != nullptr) o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
+      },
+      0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })};
+}
+
 std::vector<Option<FlowBalanceOptions>> flow_rows() {
   using O = FlowBalanceOptions;
   return learning_options<O>() + supply_options<O>() +
@@ -269,16 +280,7 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
                  "leak at 40 degC that is never an alarm [m^3/(s Pa)]; the default scales like "
                  "design_leak's",
                  [](O& o) -> double& { return o.min_leak; })} +
-         drift_options<O>(1.0) +
-         std::vector<Option<O>>{other_option<O>(
-             "estimate_supply", "", "true, false",
-             "without `ps`: the supply from the chambers at rest",
-             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-               if (node != nullptr) {
-                 o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
-               }
-             },
-             0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
+         drift_options<O>(1.0) + estimate_supply_options<O>() +
          std::vector<Option<O>>{
              number_option<O>("min_rest_loads", 1.0, 100.0,
                               "learning needs blocks at rest at this many distinct loads",
@@ -377,17 +379,7 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
                               [](O& o) -> double& { return o.rest_speed; })} +
-         drift_options<O>(1.0) +
-         std::vector<Option<O>>{other_option<O>(
-             "estimate_supply", "", "true, false",
-             "without `ps`: the supply from the chambers at rest",
-             [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-               if (node != nullptr) {
-                 o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
-               }
-             },
-             0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })} +
-         oil_options<O>();
+         drift_options<O>(1.0) + estimate_supply_options<O>() + oil_options<O>();
 }
 
 FlowLawOptions flow_law_options(const config::ConfigNode* node, const AvailableSignals&,
