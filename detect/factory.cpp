@@ -81,9 +81,9 @@ std::vector<Option<O>> excitation_options() {
           number_option<O>("max_excitation_wait_seconds", 0.0, kMaxOptionSeconds,
                            "after waiting this long for excitation: cannot_learn [s]",
                            [](O& o) -> double& { return o.max_excitation_wait_seconds; }),
-          number_option<O>("regime_tolerance", 0.0, 1000.0,
-                           "excitation off its learned model by more block spreads is not judged "
-                           "(outside_learned_regime); 0: judged in any regime",
+          number_option<O>("regime_tolerance", 0.0, 1.0,
+                           "how far the share of hops at rest over 8 blocks may lie outside its "
+                           "learned range (else outside_learned_regime); 0: judged in any regime",
                            [](O& o) -> double& { return o.regime_tolerance; })};
 }
 
