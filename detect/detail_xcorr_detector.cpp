@@ -198,6 +198,7 @@ Decision DetailXcorrDetector::update(const Observation& observation) {
   // For the operator: the paper's index of the chamber, not the feature's scale.
   decision.index = use_p2_alone_ ? observation.index_p2 : observation.index_p1;
   decision.judge_by_score();
+  verdict.apply_to(decision);
   return decision;
 }
 

@@ -57,12 +57,13 @@ enum class NotJudgedReason {
   outside_learned_loads,   // at rest at a load the learning data never covered
   supply_settling,         // the supply pressure is still moving after a step
   no_excitation,           // pressure-only: the index is far below its learned level (a hold)
+  outside_learned_regime,  // pressure-only: the program excites the mode unlike any learned one
   data_gap,                // the observations lack a signal the detector needs
   sensor_fault,            // a channel is faulty or suspect: the detector is not fed
 };
 
 // The names the daemon uses for the reasons (/status, metrics labels, events), in enum order.
-inline constexpr std::array<std::string_view, 11> kNotJudgedReasonNames = {"none",
+inline constexpr std::array<std::string_view, 12> kNotJudgedReasonNames = {"none",
                                                                            "learning",
                                                                            "waiting_for_excitation",
                                                                            "cannot_learn",
@@ -71,6 +72,7 @@ inline constexpr std::array<std::string_view, 11> kNotJudgedReasonNames = {"none
                                                                            "outside_learned_loads",
                                                                            "supply_settling",
                                                                            "no_excitation",
+                                                                           "outside_learned_regime",
                                                                            "data_gap",
                                                                            "sensor_fault"};
 

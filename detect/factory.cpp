@@ -70,6 +70,23 @@ std::vector<Option<O>> supply_settle_options() {
                            [](O& o) -> double& { return o.supply_settle_seconds; })};
 }
 
+// The feature test under test programs (feature_test.hpp, issue 23): learning that waits for the
+// mode to ring, and judging in the learned regime only.
+template <class O>
+std::vector<Option<O>> excitation_options() {
+  return {number_option<O>("min_excitation_range", 0.0, 10.0,
+                           "learning needs this spread of the block log load activity (10-90 %); "
+                           "0: any period (waiting_for_excitation)",
+                           [](O& o) -> double& { return o.min_excitation_range; }),
+          number_option<O>("max_excitation_wait_seconds", 0.0, kMaxOptionSeconds,
+                           "after waiting this long for excitation: cannot_learn [s]",
+                           [](O& o) -> double& { return o.max_excitation_wait_seconds; }),
+          number_option<O>("regime_tolerance", 0.0, 1.0,
+                           "how far the share of hops at rest over 8 blocks may lie outside its "
+                           "learned range (else outside_learned_regime); 0: judged in any regime",
+                           [](O& o) -> double& { return o.regime_tolerance; })};
+}
+
 // The oil grade (MODEL.md "Drifting operating conditions"): `oil_grade` 32, 46 or 68, or the
 // two data-sheet viscosities `oil_viscosity_40` and `oil_viscosity_100` [mm^2/s]; the rig's oil
 // (VG 46 unless its description says otherwise) when neither is given.
@@ -189,7 +206,8 @@ std::vector<Option<IndexCusumOptions>> index_rows() {
                               "below this share of its learned level the index is not judged "
                               "(no_excitation: a hold)",
                               [](O& o) -> double& { return o.no_excitation_share; })} +
-         drift_options<O>(0.0) + supply_settle_options<O>() + oil_options<O>();
+         drift_options<O>(0.0) + supply_settle_options<O>() + excitation_options<O>() +
+         oil_options<O>();
 }
 
 void check_index(const IndexCusumOptions& o, const config::ConfigNode& node) {
@@ -428,7 +446,7 @@ std::vector<Option<DetailXcorrOptions>> xcorr_rows() {
                           option_number_text(o.min_shift_ratio) + " (ln band ratio)";
                  })} +
          false_alarm_options<O>() + supply_options<O>() + drift_options<O>(0.0) +
-         supply_settle_options<O>();
+         supply_settle_options<O>() + excitation_options<O>();
 }
 
 void check_xcorr(const DetailXcorrOptions& o, const config::ConfigNode& node) {

@@ -63,8 +63,10 @@ FeatureTest::FeatureTest(const FeatureTestOptions& options, const FeaturePhysics
       supply_(supply_options(options, block_hops_)),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds),
              kCusumHistoryBlocks),
-      drift_(drift_options(options, physics)) {
+      drift_(drift_options(options, physics)),
+      regime_(kRegimeBlocks) {
   learned_.reserve(clock_.learn_hops() / block_hops_ + 1);
+  scratch_.reserve(learned_.capacity());
   coefficients_[4] = physics.temperature_prior;
 }
 
@@ -74,7 +76,13 @@ void FeatureTest::reset() {
   std::fill(std::begin(coefficients_), std::end(coefficients_), 0.0);
   coefficients_[4] = physics_.temperature_prior;
   block_sigma_ = kMissing;
-  block_hop_ = block_valid_ = 0;
+  learned_rest_low_ = learned_rest_high_ = kMissing;
+  regime_.clear();
+  outside_ = false;
+  excitation_wait_seconds_ = 0.0;
+  cannot_learn_ = false;
+  waits_for_excitation_ = true;
+  block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
   previous_load_ = previous_rough_load_ = last_expected_ = kMissing;
@@ -92,6 +100,9 @@ void FeatureTest::resume_after_gap() {
   previous_load_ = previous_rough_load_ = kMissing;
   chamber_supply_.resume_after_gap();
   cusum_.forget_history();
+  // The regime's blocks are on the old clock too (their residuals never reach the reference).
+  regime_.clear();
+  outside_ = false;
 }
 
 // Load pressure p1 - p2 over supply; with one chamber, that chamber's departure from mid-supply
@@ -175,6 +186,7 @@ bool FeatureTest::add_to_block(const Observation& o, double temp, double feature
       sum_log_friction_ -= std::log(sim::friction_factor(physics_.oil.ratio(temp)));
     }
     ++block_valid_;
+    if (activity < kRestActivity) ++rest_hops_;
   }
   if (++block_hop_ < block_hops_) return false;
   const bool enough = 2 * block_valid_ >= block_hops_;
@@ -186,9 +198,10 @@ bool FeatureTest::add_to_block(const Observation& o, double temp, double feature
                  sum_load_squared_ / n,
                  std::log(sum_activity_ / n + kActivityFloor),
                  sum_log_friction_ / n,
-                 sum_log_supply_ / n};
+                 sum_log_supply_ / n,
+                 static_cast<double>(rest_hops_) / n};
   }
-  block_hop_ = block_valid_ = 0;
+  block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
   return enough;
@@ -250,6 +263,80 @@ void FeatureTest::finish_learning() {
   const auto n = learned_.size();
   const double sigma = std::sqrt(sum_sq / static_cast<double>(n - kRegressors));
   block_sigma_ = cusum_block_sigma(sigma, n, lag_one_correlation(sum_lag, sum_sq));
+
+  // The regime learned: the range of the share of hops at rest over kRegimeBlocks blocks.
+  if (!(options_.regime_tolerance > 0.0) || n < kRegimeBlocks) return;
+  for (const auto& b : learned_) {
+    if (std::isnan(b.rest_share)) return;  // blocks of a state from before issue 23
+  }
+  double low = 1.0, high = 0.0, sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum += learned_[i].rest_share;
+    if (i >= kRegimeBlocks) sum -= learned_[i - kRegimeBlocks].rest_share;
+    if (i + 1 < kRegimeBlocks) continue;
+    const double mean = sum / static_cast<double>(kRegimeBlocks);
+    low = std::min(low, mean);
+    high = std::max(high, mean);
+  }
+  learned_rest_low_ = low;
+  learned_rest_high_ = high;
+}
+
+// The spread of the learning period's block log load activity (10 % to 90 % quantile): a
+// program that rings the mode (steps) moves and rests, and its blocks span both; a hold rests
+// throughout, a sine or a triangle moves at one steady pace. The regressors of the feature's
+// model are identified only in the first case (a hold makes the load and the activity
+// constants), and the steady programs the regime test recognises against it.
+bool FeatureTest::excited_enough() {
+  if (!waits_for_excitation_ || !(options_.min_excitation_range > 0.0)) return true;
+  scratch_.clear();
+  for (const auto& b : learned_) scratch_.push_back(b.log_activity);  // capacity reserved
+  if (scratch_.size() < 2 * kRegressors) return true;  // too little data: finish_learning says so
+  const auto at = [this](double q) {
+    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(scratch_.size() - 1));
+    std::nth_element(scratch_.begin(), scratch_.begin() + k, scratch_.end());
+    return scratch_[static_cast<std::size_t>(k)];
+  };
+  const double low = at(0.1), high = at(0.9);
+  return high - low >= options_.min_excitation_range;
+}
+
+// The share of hops at rest over the last kRegimeBlocks blocks against the learned range,
+// widened by regime_tolerance: steps move and rest, a sine, sweep or triangle hardly rests, a
+// hold does nothing else, and a leak changes none of it. On entering an excursion the blocks
+// since it began (those in the ring) are taken back out of the CUSUM and never reach the drift
+// reference; blocks leaving the ring in the regime do.
+bool FeatureTest::outside_regime(const Block& block) {
+  if (!regime_known()) return false;
+  if (regime_.full() && !std::isnan(regime_.oldest().residual)) {
+    drift_.add(regime_.oldest().t, regime_.oldest().residual);
+  }
+  regime_.push({block.t, block.rest_share, kMissing});
+  if (!regime_.full()) return outside_;  // after a gap: too few blocks to say
+  double sum = 0.0;
+  for (std::size_t i = 0; i < regime_.size(); ++i) sum += regime_.oldest(i).share;
+  const double share = sum / static_cast<double>(regime_.size());
+  // Back in the regime only well inside: a program near the edge would otherwise flicker in
+  // and out, judged by halves.
+  const double margin = outside_ ? 0.5 * options_.regime_tolerance : options_.regime_tolerance;
+  const bool outside = share < learned_rest_low_ - margin || share > learned_rest_high_ + margin;
+  if (outside && !outside_) {
+    cusum_.take_back_after(regime_.oldest().t - 0.5 * options_.block_seconds);
+    // The ring's blocks were judged in the new program: none of them enters the reference.
+    for (std::size_t age = 0; age < regime_.size(); ++age) regime_.newest(age).residual = kMissing;
+  }
+  outside_ = outside;
+  return outside;
+}
+
+// A healthy block's residual for the drift reference: through the regime ring when the block
+// went into it (it enters once kRegimeBlocks later blocks showed no excursion), else at once.
+void FeatureTest::add_to_reference(const Block& block, double residual) {
+  if (regime_known() && !regime_.empty() && regime_.newest().t == block.t) {
+    regime_.newest().residual = residual;
+  } else {
+    drift_.add(block.t, residual);
+  }
 }
 
 double FeatureTest::anchored_until() const {
@@ -270,10 +357,31 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
   const bool completed = add_to_block(o, temp, feature, load_of(o, supply), supply, block);
   if (!clock_.learned()) {
     if (completed) learned_.push_back(block);  // capacity reserved: never reallocates
-    if (clock_.period_over()) finish_learning();
-    return verdict;
+    if (clock_.period_over()) {
+      if (excited_enough()) {
+        finish_learning();
+      } else if (excitation_wait_seconds_ >= options_.max_excitation_wait_seconds) {
+        // A baseline of an unexcited rig would read the first excited program as a leak.
+        cannot_learn_ = true;
+        learned_.clear();
+        clock_.set_learned();
+      } else {
+        excitation_wait_seconds_ += options_.learning.learn_seconds;
+        learned_.clear();
+        clock_.restart_period();
+        verdict.learning_hops_left = clock_.hops_left();
+      }
+    }
+    if (excitation_wait_seconds_ > 0.0 && !clock_.learned()) {
+      verdict.not_judged = NotJudgedReason::waiting_for_excitation;
+    }
+    if (!cannot_learn_) return verdict;
   }
   verdict.learning = false;
+  if (cannot_learn_) {
+    verdict.not_judged = NotJudgedReason::cannot_learn;
+    return verdict;
+  }
   if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) return verdict;
   if (completed && !chamber_supply_.awaiting()) {
     const double residual = block.feature - expected_feature(block);
@@ -285,6 +393,8 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
         !std::isnan(step_time) && block.t - step_time < options_.supply_settle_seconds;
     if (anchoring) {
       drift_.add(block.t, residual);
+    } else if (outside_regime(block)) {
+      verdict.not_judged = NotJudgedReason::outside_learned_regime;
     } else {
       // Log-likelihood ratio of "the mean residual is design_shift" against "null_shift", per
       // block.
@@ -293,8 +403,10 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
       const double z = (residual - reference) / block_sigma_;
       cusum_.add(block.t, (shift - null_shift) * (z - (shift + null_shift) / 2.0));
       // Blocks under suspicion stay out of the reference: a leak is never learned as drift.
-      if (cusum_.normalised() < 0.5) drift_.add(block.t, residual);
+      if (cusum_.normalised() < 0.5) add_to_reference(block, residual);
     }
+  } else if (outside_) {
+    verdict.not_judged = NotJudgedReason::outside_learned_regime;
   }
   verdict.expected = last_expected_;
   verdict.score = cusum_.normalised();
@@ -310,6 +422,14 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
               coefficients_[i]);
   }
   state.put(key("block_sigma"), block_sigma_);
+  state.put(key("regime.rest_low"), learned_rest_low_);
+  state.put(key("regime.rest_high"), learned_rest_high_);
+  save_ring(state, key("regime.blocks"), regime_, kRegimeFields);
+  state.put(key("regime.outside"), outside_ ? 1.0 : 0.0);
+  state.put(key("excitation.wait_seconds"), excitation_wait_seconds_);
+  state.put(key("excitation.cannot_learn"), cannot_learn_ ? 1.0 : 0.0);
+  state.put(key("excitation.waits"), waits_for_excitation_ ? 1.0 : 0.0);
+  state.put_count(key("block.rest_hops"), rest_hops_);
   state.put_count(key("block.hops"), block_hop_);
   state.put_count(key("block.valid"), block_valid_);
   state.put(key("block.sum_feature"), sum_feature_);
@@ -344,9 +464,17 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
         key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])));
   }
   block_sigma_ = state.get(key("block_sigma"));
+  learned_rest_low_ = state.get(key("regime.rest_low"));
+  learned_rest_high_ = state.get(key("regime.rest_high"));
+  restore_ring(state, key("regime.blocks"), regime_, kRegimeFields);
+  outside_ = state.get(key("regime.outside")) != 0.0;
+  excitation_wait_seconds_ = state.get(key("excitation.wait_seconds"));
+  cannot_learn_ = state.get(key("excitation.cannot_learn")) != 0.0;
+  waits_for_excitation_ = state.get(key("excitation.waits")) != 0.0;
+  rest_hops_ = state.get_count(key("block.rest_hops"));
   block_hop_ = state.get_count(key("block.hops"));
   block_valid_ = state.get_count(key("block.valid"));
-  if (block_hop_ >= block_hops_ || block_valid_ > block_hop_) {
+  if (block_hop_ >= block_hops_ || block_valid_ > block_hop_ || rest_hops_ > block_valid_) {
     throw StateError("block position out of range");
   }
   sum_feature_ = state.get(key("block.sum_feature"));

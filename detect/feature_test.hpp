@@ -19,6 +19,21 @@
 //   judge until the holds after the step give the new supply, then re-anchors as above.
 // - What is left of slow drift is followed (DriftReference): blocks are judged against a trend
 //   of the residuals in a window that ends `drift_guard_seconds` ago.
+// Test programs (MODEL.md "Test programs", issue 23) change the excitation by orders of
+// magnitude, and with it every feature the pressures give:
+// - Learning waits for a program that moves and rests (steps, which ring the mode): a learning
+//   period whose blocks' log load activity spans less than `min_excitation_range` (a hold, a
+//   steady sine) is discarded and learning starts over (`waiting_for_excitation`), for at most
+//   `max_excitation_wait_seconds`, then `cannot_learn`. A baseline learned on an unexcited hold
+//   reads the first steps as a leak (its load and activity regressors were constants).
+// - The program is told by how much it rests: the share of hops at rest over kRegimeBlocks
+//   blocks (steps move and rest, a sine, sweep or triangle hardly rests, a hold only rests; a
+//   leak changes none of it). Its range over the learning period is the regime learned; where
+//   the share lies further outside it than `regime_tolerance`, the program is one the learning
+//   did not see (`outside_learned_regime`): its blocks go neither into the CUSUM nor into the
+//   drift reference, and the blocks since the excursion began are taken back out of both. The
+//   feature's model (learned on steps) does not hold there: a 0.5 Hz sine rings the mode less,
+//   which read as a leak.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -33,6 +48,7 @@
 #include "detect/detector.hpp"
 #include "detect/drift_reference.hpp"
 #include "detect/learning_schedule.hpp"
+#include "detect/ring.hpp"
 #include "detect/supply_tracker.hpp"
 #include "sim/oil.hpp"
 #include "sim/parameters.hpp"
@@ -51,6 +67,13 @@ struct FeatureTestOptions {
   double drift_window_seconds = 240.0;
   // After a supply step: no judging for this long while the reference re-anchors.
   double supply_settle_seconds = 20.0;
+  // Learning waits for excitation (see the file comment): the spread (10 % to 90 % quantile)
+  // of the learning period's block log load activity it needs; 0 learns from any period.
+  double min_excitation_range = 1.0;
+  double max_excitation_wait_seconds = 1800.0;
+  // Judging only in the learned regime: how far (as a share of hops) the rest share of the last
+  // kRegimeBlocks blocks may lie outside the learned range; 0 judges in any regime.
+  double regime_tolerance = 0.15;
 };
 
 // What the feature is: how a leak, the supply and the oil move it.
@@ -81,7 +104,17 @@ class FeatureTest {
     double score = kMissing;               // CUSUM / threshold; NaN when it cannot judge
     // The healthy feature (drift reference included) the latest judged block was held against.
     double expected = kMissing;
+    // Why the test does not judge (none while it does, and while it is merely learning).
+    NotJudgedReason not_judged = NotJudgedReason::none;
+    // After Decision::judge_by_score(): the test's reason, where it has one, overrides.
+    void apply_to(Decision& decision) const {
+      if (not_judged == NotJudgedReason::none) return;
+      decision.judged = false;
+      decision.not_judged_reason = not_judged;
+    }
   };
+  // Blocks whose rest shares are averaged for the regime test.
+  static constexpr std::size_t kRegimeBlocks = 8;
   // One hop: `feature` over the window that ended at o.t (NaN: a gap; nothing is judged then),
   // with the observation's pressures (and its temperature when the physics uses it).
   Verdict update(const Observation& o, double feature);
@@ -102,21 +135,37 @@ class FeatureTest {
  private:
   // One block's means: the response and its regressors.
   struct Block {
-    double t, feature, load, load_squared, log_activity, log_friction, log_supply;
+    double t, feature, load, load_squared, log_activity, log_friction, log_supply, rest_share;
   };
-  static constexpr std::array<RecordField<Block>, 7> kBlockFields = {
+  static constexpr std::array<RecordField<Block>, 8> kBlockFields = {
       record_field<&Block::t>("t"),
       record_field<&Block::feature>("feature"),
       record_field<&Block::load>("load"),
       record_field<&Block::load_squared>("load_squared"),
       record_field<&Block::log_activity>("log_activity"),
       record_field<&Block::log_friction>("log_friction"),
-      record_field<&Block::log_supply>("log_supply")};
+      record_field<&Block::log_supply>("log_supply"),
+      record_field<&Block::rest_share>("rest_share")};
+  // A block of the regime test: its share of hops at rest, and its feature residual
+  // waiting to enter the drift reference (NaN: it does not) until kRegimeBlocks later blocks
+  // showed no excursion.
+  struct RegimeEntry {
+    double t, share, residual;
+  };
+  static constexpr std::array<RecordField<RegimeEntry>, 3> kRegimeFields = {
+      record_field<&RegimeEntry::t>("t"), record_field<&RegimeEntry::share>("share"),
+      record_field<&RegimeEntry::residual>("residual")};
   static constexpr int kRegressors = 5;
   double load_of(const Observation& o, double supply) const;
   double expected_feature(const Block& block) const;
   bool add_to_block(const Observation& o, double temp, double feature, double load, double supply,
                     Block& completed);
+  // At the end of a learning period: whether its blocks show the mode ringing.
+  bool excited_enough();
+  // Whether the block lies outside the learned regime (it joins the regime ring).
+  bool outside_regime(const Block& block);
+  void add_to_reference(const Block& block, double residual);
+  bool regime_known() const { return !std::isnan(learned_rest_low_); }
   double supply_for(const Observation& o, double load);
   double supply_from_chamber(const Observation& o, double load);
   void finish_learning();
@@ -129,10 +178,20 @@ class FeatureTest {
   std::vector<Block> learned_;  // reserved at construction
   double coefficients_[kRegressors] = {0.0, 0.0, 0.0, 0.0, 0.0};
   double block_sigma_ = kMissing;  // long-run std. dev. of a block's residual
+  // The learned range of the rest share; NaN when not learned (a state from before issue 23:
+  // then every block is judged).
+  double learned_rest_low_ = kMissing, learned_rest_high_ = kMissing;
+  bool outside_ = false;
+  double excitation_wait_seconds_ = 0.0;  // learning periods discarded for want of excitation
+  bool cannot_learn_ = false;
+  // Whether learning waits for excitation; off for a state from a build before it.
+  bool waits_for_excitation_ = true;
+  std::vector<double> scratch_;  // quantiles at the end of learning; reserved at construction
   // The block being filled.
   std::size_t block_hop_ = 0, block_valid_ = 0;
   double sum_feature_ = 0.0, sum_load_ = 0.0, sum_load_squared_ = 0.0, sum_activity_ = 0.0;
   double sum_log_friction_ = 0.0, sum_log_supply_ = 0.0;
+  std::size_t rest_hops_ = 0;  // the block's valid hops at rest
   double previous_load_ = kMissing;
   double previous_rough_load_ = kMissing;  // normalised by the configured supply
   double last_expected_ = kMissing;
@@ -143,6 +202,7 @@ class FeatureTest {
   double learned_supply_ = kMissing;  // the supply the learning period's blocks were formed with
   BlockCusum cusum_;
   DriftReference drift_;
+  Ring<RegimeEntry> regime_;  // the latest kRegimeBlocks judged or excluded blocks
 };
 
 }  // namespace leakmon::detect

@@ -57,6 +57,7 @@ Decision IndexCusumDetector::update(const Observation& observation) {
   decision.score = verdict.score;
   decision.baseline = std::isnan(verdict.expected) ? kMissing : std::exp(verdict.expected);
   decision.judge_by_score();
+  verdict.apply_to(decision);
   if (decision.judged && decision.index < no_excitation_share_ * decision.baseline) {
     decision.judged = false;
     decision.not_judged_reason = NotJudgedReason::no_excitation;

@@ -1,5 +1,7 @@
 #include "detect/legacy_state.hpp"
 
+#include "detect/feature_test.hpp"
+
 #include <cmath>
 #include <initializer_list>
 #include <limits>
@@ -251,6 +253,31 @@ DetectorState xcorr_from_1(const DetectorState& old) {
   return c.out();
 }
 
+// The feature test before issue 23 (index_cusum 4, detail_xcorr 2 under "test."): no
+// excitation column, no regime model, no wait. The converted test judges as that build did:
+// the regime model is unknown (every block judged) and learning does not wait.
+DetectorState feature_test_from_issue_26(const DetectorState& old, int version,
+                                         std::string_view prefix) {
+  Conversion c(old, version);
+  for (const auto& [key, values] : old.entries()) c.put(key, values);
+  const auto key = [prefix](std::string_view name) { return state_key(prefix, name); };
+  const std::size_t learned = c.list(key("learned.t")).size();
+  c.put(key("learned.rest_share"), std::vector<double>(learned, kNaN));
+  c.put(key("regime.rest_low"), kNaN);
+  c.put(key("regime.rest_high"), kNaN);
+  c.put(key("regime.blocks.t"), std::span<const double>());
+  c.put(key("regime.blocks.share"), std::span<const double>());
+  c.put(key("regime.blocks.residual"), std::span<const double>());
+  c.out().put_count(key("regime.blocks.next"), 0);
+  c.out().put_count(key("regime.blocks.capacity"), FeatureTest::kRegimeBlocks);
+  c.put(key("regime.outside"), 0.0);
+  c.put(key("excitation.wait_seconds"), 0.0);
+  c.put(key("excitation.cannot_learn"), 0.0);
+  c.put(key("excitation.waits"), 0.0);
+  c.out().put_count(key("block.rest_hops"), 0);
+  return c.out();
+}
+
 }  // namespace
 
 DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
@@ -262,6 +289,18 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
     }
     if (kind == "flow_balance" && state.version() == 3 && version == 4) return flow_from_3(state);
     if (kind == "index_cusum" && state.version() == 3 && version == 4) return index_from_3(state);
+    if (kind == "index_cusum" && state.version() == 3 && version == 5) {
+      return feature_test_from_issue_26(index_from_3(state), 5, "");
+    }
+    if (kind == "index_cusum" && state.version() == 4 && version == 5) {
+      return feature_test_from_issue_26(state, 5, "");
+    }
+    if (kind == "detail_xcorr" && state.version() == 1 && version == 3) {
+      return feature_test_from_issue_26(xcorr_from_1(state), 3, "test");
+    }
+    if (kind == "detail_xcorr" && state.version() == 2 && version == 3) {
+      return feature_test_from_issue_26(state, 3, "test");
+    }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
     if (kind == "detail_xcorr" && state.version() == 1 && version == 2) return xcorr_from_1(state);
   }

@@ -41,6 +41,9 @@ class Ring {
   const T& newest(std::size_t age = 0) const {
     return slots_[(next_ + slots_.size() - 1 - age) % slots_.size()];
   }
+  T& newest(std::size_t age = 0) {
+    return slots_[(next_ + slots_.size() - 1 - age) % slots_.size()];
+  }
   // i 0: the oldest; i < size().
   const T& oldest(std::size_t i = 0) const {
     return slots_[(next_ + slots_.size() - count_ + i) % slots_.size()];

@@ -75,7 +75,9 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
   const std::vector<std::string> index = with_learning(
       {"design_drop", "false_alarms_per_hour", "block_seconds", "supply_pressure", "tank_pressure",
        "min_drop", "temperature_prior", "temperature_prior_sigma", "no_excitation_share",
-       "drift_guard_seconds", "drift_window_seconds", "supply_settle_seconds", "oil_grade",
+       "drift_guard_seconds", "drift_window_seconds", "supply_settle_seconds",
+       // issue 23: learning waits for excitation, judged in the learned regime
+       "min_excitation_range", "max_excitation_wait_seconds", "regime_tolerance", "oil_grade",
        "oil_viscosity_40", "oil_viscosity_100"});
   const std::vector<std::string> flow =
       with_learning({"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
@@ -99,7 +101,8 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
       {"detail_xcorr",
        with_learning({"design_shift", "min_shift", "false_alarms_per_hour", "block_seconds",
                       "supply_pressure", "tank_pressure", "drift_guard_seconds",
-                      "drift_window_seconds", "supply_settle_seconds"})},
+                      "drift_window_seconds", "supply_settle_seconds", "min_excitation_range",
+                      "max_excitation_wait_seconds", "regime_tolerance"})},
       {"flow_law", with_learning({"supply_pressure",
                                   "tank_pressure",
                                   "command_full_scale",
