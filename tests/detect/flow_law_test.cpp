@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "config/yaml_reader.hpp"
 #include "detect/factory.hpp"
 #include "detect/flow_law_detector.hpp"
 #include "sim/simulate.hpp"
@@ -190,6 +191,26 @@ TEST(FlowLaw, HoldAtTheSpringsRestIsSaidAsNotJudged) {
   EXPECT_TRUE(sine.last.judged);
   EXPECT_EQ(sine.last.not_judged_reason, NotJudgedReason::none);
   EXPECT_LT(sine.max_score, detector.raise_threshold());
+}
+
+// judged_memory_seconds is an option (as flow_balance's): configured longer than the hold at the
+// spring's rest, the hold's decisions stay judged; the default (10 s) says no_load there.
+TEST(FlowLaw, JudgedMemoryIsConfigured) {
+  std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 130.0),
+                                    phase(sim::PhaseKind::hold, 0.0)};
+  phases[1].X = 0.0;
+  const capture::Capture capture = sim::simulate(program(7, phases, 160.0));
+  const auto node = config::ConfigNode::load_string("judged_memory_seconds: 60\n", "f.yaml");
+  auto configured = make_detector("flow_law", {true, true, true, true}, kHop, &node);
+  auto* long_memory = dynamic_cast<FlowLawDetector*>(configured.get());
+  ASSERT_NE(long_memory, nullptr);
+  const Outcome remembered = run(*long_memory, capture, 1e9);
+  EXPECT_FALSE(remembered.last.learning);
+  EXPECT_TRUE(remembered.last.judged);
+  FlowLawDetector by_default = make();
+  const Outcome forgotten = run(by_default, capture, 1e9);
+  EXPECT_FALSE(forgotten.last.judged);
+  EXPECT_EQ(forgotten.last.not_judged_reason, NotJudgedReason::no_load);
 }
 
 // A detector restored from another's state mid-run (mid-block) decides as that one would.
