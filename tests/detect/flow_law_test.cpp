@@ -213,6 +213,29 @@ TEST(FlowLaw, JudgedMemoryIsConfigured) {
   EXPECT_EQ(forgotten.last.not_judged_reason, NotJudgedReason::no_load);
 }
 
+// A leak that opens while learning is learned as healthy; the probe says so once learning ends,
+// near its onset and sized as a leak. The same run without the leak says nothing.
+TEST(FlowLaw, ALeakOpeningWhileLearningIsReported) {
+  const std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 0.0)};
+  sim::Scenario healthy = program(11, phases, 110.0);
+  sim::Scenario leaking = healthy;
+  constexpr double kOnset = 65.0;
+  leaking.effects.internal_leakage = sim::InternalLeakage{2e-12, kOnset, 0.0};
+  FlowLawDetector clean = make();
+  const Outcome h = run(clean, sim::simulate(healthy), 1e9);
+  ASSERT_FALSE(h.last.learning);
+  EXPECT_FALSE(clean.learned_change().has_value());
+  FlowLawDetector detector = make();
+  const Outcome l = run(detector, sim::simulate(leaking), 1e9);
+  ASSERT_FALSE(l.last.learning);
+  const auto change = detector.learned_change();
+  ASSERT_TRUE(change.has_value());
+  EXPECT_EQ(change->feature, "flow_residual");
+  EXPECT_NEAR(change->change_t, kOnset, 3.0);
+  EXPECT_GT(change->size, 1e-12);
+  EXPECT_LT(change->size, 4e-12);
+}
+
 // A detector restored from another's state mid-run (mid-block) decides as that one would.
 TEST(FlowLaw, StateRoundTripDecidesTheSame) {
   std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 50.0),
