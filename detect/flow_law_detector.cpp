@@ -82,6 +82,13 @@ void FlowLawDetector::reset() {
 void FlowLawDetector::resume_after_gap() {
   drift_.clear();
   supply_tracker_.resume_after_gap();
+  restart_block();
+}
+
+// The block integrates from its first sample's x, p1, p2 to its last: hops the detector did not
+// see (the daemon holds it while a channel is faulty) would leave the block's ends apart from the
+// flow integrated between them, one block of many spreads.
+void FlowLawDetector::restart_block() {
   previous_x_ = kMissing;
   opening_ = previous_command_ = kMissing;
   have_previous_ = false;
@@ -130,6 +137,7 @@ void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
 }
 
 Decision FlowLawDetector::update(const Observation& o) {
+  if (o.t - last_t_ > 1.5 * hop_seconds_) restart_block();  // false when NaN
   const double speed = (o.x - previous_x_) / hop_seconds_;
   previous_x_ = o.x;
   double reading = kMissing;

@@ -110,6 +110,7 @@ class FlowLawDetector final : public Detector {
   static Eigen::Vector4d regressors(const Block& b) { return {b.move, b.load, b.comp, b.length}; }
   double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
 
+  void restart_block();
   void add_sample(double u, double x, double p1, double p2);
   void close_block(double t, bool past_settling);
   void learn(const Block& b);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "config/yaml_reader.hpp"
 #include "detect/factory.hpp"
@@ -236,6 +237,30 @@ TEST(FlowLaw, ALeakOpeningWhileLearningIsReported) {
   EXPECT_LT(change->size, 4e-12);
 }
 
+// The daemon holds the detector while a channel is faulty (no update at all): the first block
+// after the hold must not integrate from x, p1, p2 before it. A healthy steps-then-sine run
+// learned, then held for 5-25 s (so that the sine's position and load differ across the hold)
+// stays quiet.
+TEST(FlowLaw, HopsNotSeenDoNotMakeABlock) {
+  std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 120.0),
+                                    phase(sim::PhaseKind::sine, 0.0)};
+  phases[1].F = 0.7;
+  phases[1].A = 0.03;
+  const capture::Capture capture = sim::simulate(program(13, phases, 200.0));
+  const std::size_t hold_from = 150 * 500 + 7 * kStep;
+  FlowLawDetector learned = make();
+  const Outcome before = run(learned, capture, 1e9, 0, hold_from);
+  ASSERT_FALSE(before.last.learning);
+  double worst = 0.0;
+  for (std::size_t hops = 125; hops <= 625; hops += 23) {
+    FlowLawDetector held = learned;
+    const Outcome after = run(held, capture, 1e9, hold_from + hops * kStep);
+    worst = std::max(worst, after.max_score);
+    EXPECT_LT(after.max_score, 0.5) << hops << " hops not seen";
+  }
+  std::printf("highest score after a hold: %.3f\n", worst);
+}
+
 // A detector restored from another's state mid-run (mid-block) decides as that one would.
 TEST(FlowLaw, StateRoundTripDecidesTheSame) {
   std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 50.0),
@@ -291,12 +316,12 @@ TEST(FlowLaw, UpdateAllocatesNothingAndResetStartsLearningAgain) {
   EXPECT_FALSE(std::isnan(again.last.learning_hops_left));
 }
 
-// Reachable through the registry by name, needs u and x, and is not the default.
+// Reachable through the registry by name, needs u and x, and is the default with them (issue 23).
 TEST(FlowLaw, RegistryKind) {
   AvailableSignals all;
   all.p1 = all.p2 = all.u = all.x = true;
   EXPECT_EQ(make_detector("flow_law", all, kHop, nullptr, nullptr)->name(), "flow_law");
-  EXPECT_NE(default_detector_kind(all), "flow_law");
+  EXPECT_EQ(default_detector_kind(all), "flow_law");
   AvailableSignals pressures;
   pressures.p1 = pressures.p2 = true;
   EXPECT_THROW(make_detector("flow_law", pressures, kHop, nullptr, nullptr), std::invalid_argument);
