@@ -246,6 +246,15 @@ std::vector<Option<O>> estimate_supply_options() {
       0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })};
 }
 
+// Both flow balances: how long a judged block keeps the decision judged (status, metrics).
+template <typename O>
+Option<O> judged_memory_option() {
+  return number_option<O>("judged_memory_seconds", 0.0, kMaxOptionSeconds,
+                          "a decision is judged while a block was judged at most this long "
+                          "ago [s]",
+                          [](O& o) -> double& { return o.judged_memory_seconds; });
+}
+
 std::vector<Option<FlowBalanceOptions>> flow_rows() {
   using O = FlowBalanceOptions;
   return learning_options<O>() + supply_options<O>() +
@@ -324,10 +333,7 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
                               "below this |p1 - p2| a block at rest is not judged (no_load) "
                               "[Pa]",
                               [](O& o) -> double& { return o.no_load_pressure; }),
-             number_option<O>("judged_memory_seconds", 0.0, kMaxOptionSeconds,
-                              "a decision is judged while a block was judged at most this long "
-                              "ago [s]",
-                              [](O& o) -> double& { return o.judged_memory_seconds; })} +
+             judged_memory_option<O>()} +
          oil_options<O>();
 }
 
@@ -396,7 +402,8 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               [](O& o) -> double& { return o.min_leak; }),
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
-                              [](O& o) -> double& { return o.rest_speed; })} +
+                              [](O& o) -> double& { return o.rest_speed; }),
+             judged_memory_option<O>()} +
          drift_options<O>(1.0) + estimate_supply_options<O>() + oil_options<O>();
 }
 

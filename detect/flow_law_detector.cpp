@@ -54,6 +54,7 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
       supply_tracker_(supply_options(options, hop_seconds)),
       drift_(drift_options(options, floor_slope_)) {
   learned_.reserve(learn_capacity_);
+  probe_blocks_.reserve(learn_capacity_);
 }
 
 void FlowLawDetector::reset() {
@@ -73,12 +74,21 @@ void FlowLawDetector::reset() {
   temperature_seen_ = false;
   drift_.clear();
   last_ = Decision{};
+  probe_blocks_.clear();
+  learned_change_.reset();
 }
 
 // The samples before the gap are not neighbours of the next ones: the block in progress is lost.
 void FlowLawDetector::resume_after_gap() {
   drift_.clear();
   supply_tracker_.resume_after_gap();
+  restart_block();
+}
+
+// The block integrates from its first sample's x, p1, p2 to its last: hops the detector did not
+// see (the daemon holds it while a channel is faulty) would leave the block's ends apart from the
+// flow integrated between them, one block of many spreads.
+void FlowLawDetector::restart_block() {
   previous_x_ = kMissing;
   opening_ = previous_command_ = kMissing;
   have_previous_ = false;
@@ -127,6 +137,7 @@ void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
 }
 
 Decision FlowLawDetector::update(const Observation& o) {
+  if (o.t - last_t_ > 1.5 * hop_seconds_) restart_block();  // false when NaN
   const double speed = (o.x - previous_x_) / hop_seconds_;
   previous_x_ = o.x;
   double reading = kMissing;
@@ -208,27 +219,56 @@ void FlowLawDetector::learn(const Block& b) {
   if (learned_.size() == learn_capacity_) learned_.erase(learned_.begin());
   learned_.push_back(b);
   if (!clock_.period_over()) return;
-  waiting_ = !excited();
+  waiting_ = !excited(learned_);
   if (!waiting_) finish_learning();
 }
 
 // The cross-port term is identifiable only with several loads: a hold alone makes it collinear
 // with the offset.
-bool FlowLawDetector::excited() const {
-  if (learned_.size() < 20) return false;
+bool FlowLawDetector::excited(std::span<const Block> blocks) const {
+  if (blocks.size() < 20) return false;
   double sum = 0.0, sum_sq = 0.0;
-  for (const auto& b : learned_) sum += b.mean_load;
-  const double mean = sum / static_cast<double>(learned_.size());
+  for (const auto& b : blocks) sum += b.mean_load;
+  const double mean = sum / static_cast<double>(blocks.size());
   std::size_t away = 0;  // blocks whose load differs from the mean by the spread
-  for (const auto& b : learned_) {
+  for (const auto& b : blocks) {
     sum_sq += (b.mean_load - mean) * (b.mean_load - mean);
     if (std::abs(b.mean_load - mean) >= options_.min_load_spread) ++away;
   }
   // A long hold followed by a few blocks of motion has the spread but not the loads: a quarter
   // of the blocks must be away from the mean, so that the model is not fitted to one load and
   // extrapolated to all the others.
-  return std::sqrt(sum_sq / static_cast<double>(learned_.size() - 1)) >= options_.min_load_spread &&
-         4 * away >= learned_.size();
+  return std::sqrt(sum_sq / static_cast<double>(blocks.size() - 1)) >= options_.min_load_spread &&
+         4 * away >= blocks.size();
+}
+
+// The model once more, fitted to the reference share of the learning period only; the residual
+// blocks of the whole period against it go to find_slope_step (a leak adds C_L times the load
+// term). The reference must identify the load term itself (excited), else a step at other loads
+// would be an extrapolation. The coefficients the detector keeps are not touched.
+void FlowLawDetector::probe_learned_change() {
+  learned_change_.reset();
+  probe_blocks_.clear();
+  if (learned_.empty()) return;
+  const double start = learned_.front().t;
+  const double split = start + kReferenceShare * (learned_.back().t - start);
+  const auto reference_end = std::find_if(learned_.begin(), learned_.end(),
+                                          [split](const Block& b) { return b.t > split; });
+  const std::span<const Block> reference_blocks(
+      learned_.data(), static_cast<std::size_t>(reference_end - learned_.begin()));
+  if (!excited(reference_blocks)) return;
+  LeastSquares<4> fit;
+  for (const auto& b : reference_blocks) fit.add(regressors(b), b.y);
+  const Eigen::Vector4d reference = fit.solve();
+  for (const auto& b : learned_) {
+    probe_blocks_.push_back(
+        {b.t - options_.block_seconds, b.t, b.y - reference.dot(regressors(b)), b.load});
+  }
+  SlopeStepOptions options;
+  options.floor_slope = std::max(floor_slope_, design_slope_) * reference[0];
+  options.slope_to_coefficient = flow_unit_ / options_.rig.ps / reference[0];
+  options.feature = "flow_residual";
+  learned_change_ = find_slope_step(probe_blocks_, reference_blocks.size(), options);
 }
 
 void FlowLawDetector::finish_learning() {
@@ -252,6 +292,7 @@ void FlowLawDetector::finish_learning() {
   const double dof = static_cast<double>(blocks > 4 ? blocks - 4 : 1);
   block_sigma_ = cusum_block_sigma(std::sqrt(sum_sq / dof), blocks,
                                    sum_sq > 0.0 ? lag_one_correlation(sum_lag, sum_sq) : 0.0);
+  probe_learned_change();
   clock_.set_learned();
   learned_.clear();
 }

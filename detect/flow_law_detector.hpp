@@ -18,6 +18,8 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -26,6 +28,7 @@
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
 #include "detect/drift_reference.hpp"
+#include "detect/learned_change.hpp"
 #include "detect/learning_schedule.hpp"
 #include "detect/supply_tracker.hpp"
 #include "sim/oil.hpp"
@@ -34,7 +37,8 @@
 namespace leakmon::detect {
 
 struct FlowLawOptions {
-  LearningSchedule learning{2.0, 120.0};
+  // 90 s as flow_balance's and as `leakmon evaluate` measured it (docs/detection.md).
+  LearningSchedule learning{2.0, 90.0};
   // The rig table: ps, pt, u_max, dp_lin, tau, Kv, the piston area A() and V0() are used.
   sim::Parameters rig;
   double block_seconds = 0.2;
@@ -69,6 +73,8 @@ class FlowLawDetector final : public Detector {
   DetectorState export_state() const override;
   void import_state(const DetectorState& state) override;
   void resume_after_gap() override;
+  // A leak that opened while learning (learned_change.hpp), judged once when learning ends.
+  std::optional<LearnedChange> learned_change() const override { return learned_change_; }
   double learning_seconds() const override {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
   }
@@ -104,10 +110,12 @@ class FlowLawDetector final : public Detector {
   static Eigen::Vector4d regressors(const Block& b) { return {b.move, b.load, b.comp, b.length}; }
   double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
 
+  void restart_block();
   void add_sample(double u, double x, double p1, double p2);
   void close_block(double t, bool past_settling);
   void learn(const Block& b);
-  bool excited() const;
+  bool excited(std::span<const Block> blocks) const;
+  void probe_learned_change();
   void finish_learning();
   void judge(const Block& b);
   Decision decide() const;
@@ -157,6 +165,9 @@ class FlowLawDetector final : public Detector {
   bool temperature_seen_ = false;
   DriftReference drift_;
   Decision last_;
+  // The learned-change probe's blocks (reserved as learned_) and its finding.
+  std::vector<ResidualBlock> probe_blocks_;
+  std::optional<LearnedChange> learned_change_;
 };
 
 }  // namespace leakmon::detect

@@ -37,7 +37,7 @@ std::optional<LearnedChange> find_slope_step(std::span<const ResidualBlock> bloc
     const double z = slope * std::sqrt(term_sq) / sigma;
     if (best && z <= best->z) continue;
     best = LearnedChange{
-        blocks[k].t_first, "command_residual", "u", slope * options.slope_to_coefficient, 0.0, z};
+        blocks[k].t_first, options.feature, "u", slope * options.slope_to_coefficient, 0.0, z};
   }
   if (!best || best->z < options.min_z ||
       best->size < options.floor_slope * options.slope_to_coefficient) {

@@ -54,6 +54,8 @@ struct SlopeStepOptions {
   // of one hold are correlated, so well above a single test's.
   double min_z = 6.0;
   std::size_t min_blocks_after = 4;  // a step must hold for this many blocks
+  // The residual's name in the event: the at-rest balance's command or flow_law's flow.
+  std::string_view feature = "command_residual";
 };
 
 // blocks: in time order, the first `reference_blocks` of them the reference share (whose

@@ -322,8 +322,16 @@ void ActuatorMonitor::judge_learned_change(double t, const EventPublisher& publi
   } else {
     event.leak_coefficient = change->size;
     event.leak_lpm_per_mpa = units::lpm_per_mpa(change->size);
-    size = fmt::format("the valve command at rest rose as a leak of {:.3f} l/min/MPa would need",
-                       event.leak_lpm_per_mpa);
+    // flow_law's residual is the valve's flow in any motion; flow_balance's the command at rest.
+    size = change->feature == "flow_residual"
+               ? fmt::format(
+                     "the valve's flow rose with the load as a leak of {:.3f} l/min/MPa "
+                     "would make it",
+                     event.leak_lpm_per_mpa)
+               : fmt::format(
+                     "the valve command at rest rose as a leak of {:.3f} l/min/MPa would "
+                     "need",
+                     event.leak_lpm_per_mpa);
   }
   event.message = fmt::format(
       "{}: learning may have included a leak at t={:.1f} s: {} ({:.0f} x its standard error), "

@@ -25,6 +25,7 @@ std::vector<Candidate> candidates() {
       {"detail_xcorr_temp", "detail_xcorr", true, false, false, cusum_grid, 1.0, 0.0, 0.5, true},
       // The flow balance in motion (issue 23): judges every test program, not only at rest.
       {"flow_law", "flow_law", true, true, true, cusum_grid, 1.0, 0.0, 0.5},
+      {"flow_law_temp", "flow_law", true, true, true, cusum_grid, 1.0, 0.0, 0.5, true},
   };
 }
 

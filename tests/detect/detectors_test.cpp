@@ -117,6 +117,7 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
                                   "sizing_seconds",
                                   "min_leak",
                                   "rest_speed",
+                                  "judged_memory_seconds",
                                   "drift_guard_seconds",
                                   "drift_window_seconds",
                                   "estimate_supply",

@@ -61,6 +61,24 @@ TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
   EXPECT_NE(json.find("\"feature\": \"command_residual\""), std::string::npos) << json;
 }
 
+// `detector: flow_law` looks back with its own residual (the valve's flow in any motion) and says
+// so in the event.
+TEST(LearnedChange, FlowLawReportsItsFlowResidual) {
+  const capture::Capture full = with_leak_in_learning(7, 2e-12);
+  DaemonConfig config = default_replay_config(full);
+  ASSERT_EQ(config.actuators.size(), 1u);
+  config.actuators.front().detector = "flow_law";
+  const auto found = learned_changes(replay_capture(full, config));
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found.front().feature, "flow_residual");
+  EXPECT_NEAR(found.front().change_t, kOnset, 3.0);
+  EXPECT_NE(found.front().message.find("the valve's flow rose with the load as a leak of"),
+            std::string::npos)
+      << found.front().message;
+  EXPECT_NE(found.front().message.find("the flow_law detector learned that"), std::string::npos)
+      << found.front().message;
+}
+
 // With p1 and p2 only, the raw index moves by a fifth between the blocks of a healthy test
 // program: only a leak that damps the hydraulic mode by clearly more is seen (1e-11: 9 of 12
 // such captures in docs/detection.md "A leak during learning"). Seed 210
