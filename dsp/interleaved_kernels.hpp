@@ -154,7 +154,10 @@ void right_end_output_block(const double* newest, std::span<const double> filter
 #pragma GCC unroll 8
     for (std::size_t b = 0; b < B; ++b) {
       const std::size_t f = s < reversed[b] ? reversed[b] - 1 - s : s;
-      sum[b] += filter[f] * newest[2 * b - f];
+      // Signed: the tap lies f - 2b samples before `newest + 2b`; an unsigned 2b - f would wrap,
+      // and a pointer plus a wrapped offset is undefined (Clang's UBSan pointer-overflow).
+      const auto offset = static_cast<std::ptrdiff_t>(2 * b) - static_cast<std::ptrdiff_t>(f);
+      sum[b] += filter[f] * newest[offset];
     }
   }
   for (std::size_t b = 0; b < B; ++b) out[b] = sum[b];

@@ -4,7 +4,8 @@
 #   compiling under GCC's -O3 warnings) runs the tests labelled 'long' (full-length
 #   simulations, minutes under ASan) and 'packaging' (whole-tree configures and cpack); its
 #   Debian package is installed, verified and purged;
-# - an ASan+UBSan build runs every other test;
+# - an ASan+UBSan build (Clang, so that both GCC and Clang build the tests with warnings as
+#   errors) runs every other test;
 # - a TSan build runs the threaded ones (label 'threads') again.
 # Run from the repository root (as root, or with sudo for the package step).
 set -euo pipefail
@@ -33,9 +34,18 @@ bash scripts/check-package.sh build/leakmon_*.deb
 
 # Sanitizer builds skip the benchmarks. Line tables (-g1) are all a sanitizer's report needs
 # (file and line per frame); full debug info would double the compile and link time.
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DLEAKMON_SANITIZE=address,undefined \
-  -DBUILD_TESTING=ON -DLEAKMON_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS=-O1 -DCMAKE_CXX_FLAGS_DEBUG=-g1 \
-  "${linker[@]}"
+# The ASan+UBSan build is Clang's (warnings as errors, as in every build with the tests), so that
+# both compilers build every target but the benchmarks each run, at no extra build: GCC the
+# Release one above, Clang this one. The compiler is named on the command line (CXX would be
+# ignored by an existing cache); a directory configured for another compiler is removed first,
+# because CMake's own switch deletes the cache and then configures without the -D options.
+if [ -f build-asan/CMakeCache.txt ] &&
+  ! grep -Eq '^CMAKE_CXX_COMPILER:[A-Z]+=(/usr/bin/)?clang\+\+$' build-asan/CMakeCache.txt; then
+  rm -rf build-asan
+fi
+cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
+  -DLEAKMON_SANITIZE=address,undefined -DBUILD_TESTING=ON -DLEAKMON_BUILD_BENCH=OFF \
+  -DCMAKE_CXX_FLAGS=-O1 -DCMAKE_CXX_FLAGS_DEBUG=-g1 "${linker[@]}"
 cmake --build build-asan -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE 'long|packaging'

@@ -32,8 +32,9 @@ TEST(SpscRing, HoldsExactlyItsCapacityAndKeepsOrder) {
 
 TEST(SpscRing, RejectsCapacitiesItCannotIndex) {
   EXPECT_THROW(SpscRing<int>(0), std::invalid_argument);
-  // capacity + 1 slots would wrap the index arithmetic (or the allocation size).
-  EXPECT_THROW(SpscRing<int>(std::numeric_limits<std::size_t>::max()), std::invalid_argument);
+  // capacity + 1 slots would wrap the index arithmetic (or the allocation size). Braces: with
+  // parentheses Clang reads the statement as a declaration of a variable named `...::max`.
+  EXPECT_THROW(SpscRing<int>{std::numeric_limits<std::size_t>::max()}, std::invalid_argument);
   EXPECT_THROW(SpscRing<std::uint64_t>(std::numeric_limits<std::ptrdiff_t>::max() / 8),
                std::invalid_argument);
   const SpscRing<int> one(1);
