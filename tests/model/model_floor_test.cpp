@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/calibration_fit.hpp"
+#include "model/diagnosis.hpp"
 #include "model/effect_library.hpp"
 #include "model/misfit.hpp"
 #include "model/segment_predictor.hpp"
@@ -61,6 +63,37 @@ TEST(NoiseFloor, IsWhatTheTrueModelScores) {
                 effect, achieved, mean_floor, floor[0], floor[1], floor[2]);
     EXPECT_GT(mean_floor, 0.6 * achieved) << effect;
     EXPECT_LT(mean_floor, 1.4 * achieved) << effect;
+  }
+}
+
+// The same on rigs whose pressures follow the spool flow noise up to hundreds of hertz: a light
+// piston on a large valve, the hydraulic mode far above the sampling's Nyquist frequency
+// (seed 761025 of the issue-24 evaluation: 81 mm bore, 2.4 kg, Kv 2.85e-6, 1.25 ms spool).
+// MODEL.md's noise is a continuous Ornstein-Uhlenbeck process; drawn at 0.5 ms (4 pieces per
+// sample) its share above 1 kHz was missing and the floor came out at 0.68 of what the true
+// model scores, so a healthy capture read as `unexplained`. The diagnosis's own setting must
+// come within a few per cent on such a rig and on the paper's.
+TEST(NoiseFloor, FollowsTheContinuousFlowNoiseOnAStiffLightRig) {
+  CaseSettings other = short_case();
+  other.duration_s = 60.0;
+  other.other_rig = true;
+  const DiagnosisSettings diagnosis;
+  for (const auto& [seed, settings] :
+       {std::pair{std::uint64_t{761025}, other}, std::pair{std::uint64_t{771003}, short_case()}}) {
+    const SyntheticCase c = draw_case(seed, "none", settings);
+    const MeasuredRecord record = measured_record(simulate_case(c));
+    const SegmentPredictor predictor(record, c.scenario.params);
+    const auto plan = split_record(record);
+    const ModelParameters truth = true_model(c);
+    const double achieved = predictor.nrmse(truth, plan.held_out);
+    const auto floor =
+        predictor.noise_floor(truth, plan.held_out, predictor.noise_levels(), diagnosis.floor_seed,
+                              diagnosis.floor_repeats, diagnosis.floor_noise_pieces);
+    const double mean_floor = (floor[0] + floor[1] + floor[2]) / 3.0;
+    std::printf("seed %llu: true model's held-out NRMSE %.5f, floor %.5f (ratio %.3f)\n",
+                static_cast<unsigned long long>(seed), achieved, mean_floor, mean_floor / achieved);
+    EXPECT_GT(mean_floor, 0.85 * achieved) << "seed " << seed;
+    EXPECT_LT(mean_floor, 1.2 * achieved) << "seed " << seed;
   }
 }
 
