@@ -249,7 +249,14 @@ bool ActuatorMonitor::check_repeats(double t, std::span<const double> acquired,
 void ActuatorMonitor::judge_mode_visibility(double t, const detect::Observation& observation,
                                             const EventPublisher& publish) {
   if (!mode_judged_) {
-    if (last_decision_.learning) {
+    // A rig whose described mode lies outside the band is blind whatever the index shows: said
+    // once the first learning period is over, also when the detector discarded it for want of
+    // excitation and keeps learning (it may wait for a program that moves for half an hour).
+    const bool period_over =
+        !last_decision_.learning ||
+        (mode_out_of_band_ &&
+         last_decision_.not_judged_reason == detect::NotJudgedReason::waiting_for_excitation);
+    if (!period_over) {
       mode_checks_[0].add(observation.index_p1);
       mode_checks_[1].add(observation.index_p2);
       return;

@@ -3,8 +3,10 @@
 // gives one warning (log and event) and a fresh learning phase, never a crash.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <cctype>
 
 #include <algorithm>
 #include <filesystem>
@@ -47,7 +49,7 @@ void write_capture(const std::string& dir, std::uint64_t seed, double seconds) {
 
 struct DaemonRun {
   std::string log, events, learning_metric;
-  std::string trend;  // the first /api/trend answer that held the actuator
+  std::string trend;  // the first /api/trend answer that held the actuator with a point
   int exit_code = -1;
 };
 
@@ -74,7 +76,12 @@ DaemonRun run_daemon(const std::string& dir, int port, const std::string& name) 
       [&] {
         try {
           run.trend = http::http_request("127.0.0.1", port, "GET", "/api/trend").body;
-          return run.trend.find("\"name\":\"cyl\"") != std::string::npos;
+          // The actuator with at least one point: the page may be asked before the worker has
+          // put the restored trend (or the first new point) in place.
+          const auto time = run.trend.find("\"time\":[");
+          return run.trend.find("\"name\":\"cyl\"") != std::string::npos &&
+                 time != std::string::npos && time + 8 < run.trend.size() &&
+                 std::isdigit(static_cast<unsigned char>(run.trend[time + 8]));
         } catch (const std::exception&) {
           return false;
         }
