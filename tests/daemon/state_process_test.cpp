@@ -78,10 +78,12 @@ DaemonRun run_daemon(const std::string& dir, int port, const std::string& name) 
           run.trend = http::http_request("127.0.0.1", port, "GET", "/api/trend").body;
           // The actuator with at least one point: the page may be asked before the worker has
           // put the restored trend (or the first new point) in place.
-          const auto time = run.trend.find("\"time\":[");
+          const std::string times = "\"time\":[";
+          const auto first = run.trend.find(times);
+          const auto point = first == std::string::npos ? first : first + times.size();
           return run.trend.find("\"name\":\"cyl\"") != std::string::npos &&
-                 time != std::string::npos && time + 8 < run.trend.size() &&
-                 std::isdigit(static_cast<unsigned char>(run.trend[time + 8]));
+                 point < run.trend.size() &&
+                 std::isdigit(static_cast<unsigned char>(run.trend[point]));
         } catch (const std::exception&) {
           return false;
         }

@@ -34,6 +34,17 @@ Observation rung(test::SyntheticRig& rig, double share) {
   return o;
 }
 
+// index_cusum with these options on a rig held at 20 mm for `hold_s`, its decision at `until_s`.
+Decision after_a_hold(const char* options, double hold_s, double until_s) {
+  const auto node = config::ConfigNode::load_string(options, "d.yaml");
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, &node);
+  test::SyntheticRig rig;
+  hold_at(rig, 0.02, hold_s);
+  Decision d;
+  while (rig.t < until_s) d = detector->update(rung(rig, 0.3));
+  return d;
+}
+
 // A durability block: a 0.5 Hz, 20 mm sine, which rings the mode at 0.6 of the steps' level
 // (above the no_excitation share). steps_again() hands the rig back to its steps.
 Observation sine(test::SyntheticRig& rig) {
@@ -74,22 +85,12 @@ TEST(PressureOnlyPrograms, AHoldIsNotLearnedFromAndTheWaitIsSaid) {
 // The build before learned the hold (what min_excitation_range changes, so the test above can
 // fail).
 TEST(PressureOnlyPrograms, WithoutTheWaitTheHoldIsLearned) {
-  const auto off = config::ConfigNode::load_string("min_excitation_range: 0\n", "d.yaml");
-  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, &off);
-  test::SyntheticRig rig;
-  hold_at(rig, 0.02, 300.0);
-  Decision d;
-  while (rig.t < 120.0) d = detector->update(rung(rig, 0.3));
+  const Decision d = after_a_hold("min_excitation_range: 0\n", 300.0, 120.0);
   EXPECT_FALSE(d.learning);
 }
 
 TEST(PressureOnlyPrograms, AHoldBeyondTheLongestWaitCannotLearn) {
-  const auto wait = config::ConfigNode::load_string("max_excitation_wait_seconds: 200\n", "d.yaml");
-  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, &wait);
-  test::SyntheticRig rig;
-  hold_at(rig, 0.02, 1000.0);
-  Decision d;
-  while (rig.t < 500.0) d = detector->update(rung(rig, 0.3));
+  const Decision d = after_a_hold("max_excitation_wait_seconds: 200\n", 1000.0, 500.0);
   EXPECT_FALSE(d.learning);
   EXPECT_FALSE(d.judged);
   EXPECT_EQ(d.not_judged_reason, NotJudgedReason::cannot_learn);
