@@ -377,8 +377,20 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
   return learning_options<O>() + supply_options<O>() + valve_options<O>() +
          std::vector<Option<O>>{
              number_option<O>("spool_time_constant", 1e-5, 1.0,
-                              "the spool's first-order lag tau [s]",
+                              "the spool's first-order lag tau [s]; learned around it unless "
+                              "learn_spool_time_constant is false",
                               [](O& o) -> double& { return o.rig.tau; }),
+             other_option<O>(
+                 "learn_spool_time_constant", "", "true, false",
+                 "learn the spool's lag from the learning blocks (1/8 to 8 times the stated)",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr) {
+                     o.learn_spool_time_constant =
+                         node->get_bool(row.key, o.learn_spool_time_constant);
+                   }
+                 },
+                 0.0, 0.0,
+                 [](O& o) { return std::string(o.learn_spool_time_constant ? "true" : "false"); }),
              number_option<O>("min_load_spread", 0.0, 1e9,
                               "learning waits until the learning blocks' mean loads p1 - p2 "
                               "spread this much (std) [Pa]",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
 
 #include "detect/least_squares.hpp"
@@ -53,8 +54,18 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)),
       supply_tracker_(supply_options(options, hop_seconds)),
       drift_(drift_options(options, floor_slope_)) {
+  for (std::size_t i = 0; i < kTauCandidates; ++i) {
+    const double third_octaves = static_cast<double>(i) - static_cast<double>(kStatedTau);
+    taus_[i] = options.rig.tau * std::exp2(third_octaves / 3.0);
+  }
+  reset_spool_time_constant();
   learned_.reserve(learn_capacity_);
   probe_blocks_.reserve(learn_capacity_);
+}
+
+void FlowLawDetector::reset_spool_time_constant() {
+  tau_index_ = options_.learn_spool_time_constant ? kTauNotChosen : kStatedTau;
+  fit_lag_ = options_.learn_spool_time_constant;
 }
 
 void FlowLawDetector::reset() {
@@ -64,6 +75,7 @@ void FlowLawDetector::reset() {
   block_sigma_ = kMissing;
   waiting_ = false;
   no_load_blocks_ = 0;
+  reset_spool_time_constant();
   supply_ = viscosity_ratio_ = kMissing;
   hop_usable_ = false;
   previous_x_ = kMissing;
@@ -90,11 +102,13 @@ void FlowLawDetector::resume_after_gap() {
 // flow integrated between them, one block of many spreads.
 void FlowLawDetector::restart_block() {
   previous_x_ = kMissing;
-  opening_ = previous_command_ = kMissing;
+  openings_.fill(kMissing);
+  previous_command_ = kMissing;
   have_previous_ = false;
   block_hop_ = 0;
   block_ok_ = false;
-  sum_flow_ = sum_load_ = block_length_ = ratio_sum_ = 0.0;
+  sum_flows_.fill(0.0);
+  sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
 }
 
@@ -105,22 +119,27 @@ void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
     return;
   }
   const sim::Parameters& rig = options_.rig;
-  // The spool lag, exact for a command held over each sample period (zero-order hold).
   const double command = sim::spool_command(u, rig.u_max);
   const double dt = sample_seconds_;
-  if (std::isnan(opening_)) {
-    opening_ = command;
-  } else {
-    const double keep = std::exp(-dt / rig.tau);
-    opening_ = keep * opening_ + (1.0 - keep) * previous_command_;
+  const Rungs rungs = active_rungs();
+  for (std::size_t i = rungs.first; i <= rungs.last; ++i) {
+    // The spool lag, exact for a command held over each sample period (zero-order hold).
+    double& opening = openings_[i];
+    if (std::isnan(opening)) {
+      opening = command;
+    } else {
+      const double keep = std::exp(-dt / taus_[i]);
+      opening = keep * opening + (1.0 - keep) * previous_command_;
+    }
+    const sim::ValveFlows f =
+        sim::valve_flows(opening, supply_, rig.pt, p1, p2, 1.0, rig.dp_lin, 0.0);
+    const double flow = 0.5 * (f.q1 - f.q2) / std::sqrt(rig.ps);  // in units of Kv sqrt(ps)
+    if (have_previous_) sum_flows_[i] += 0.5 * dt * (flow + previous_flows_[i]);
+    previous_flows_[i] = flow;
   }
   previous_command_ = command;
-  const sim::ValveFlows f =
-      sim::valve_flows(opening_, supply_, rig.pt, p1, p2, 1.0, rig.dp_lin, 0.0);
-  const double flow = 0.5 * (f.q1 - f.q2) / std::sqrt(rig.ps);  // in units of Kv sqrt(ps)
   const double load = p1 - p2;
   if (have_previous_) {
-    sum_flow_ += 0.5 * dt * (flow + previous_flow_);
     sum_load_ += 0.5 * dt * (load + previous_load_);
     block_length_ += dt;
   } else {
@@ -129,7 +148,6 @@ void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
     start_p2_ = p2;
   }
   have_previous_ = true;
-  previous_flow_ = flow;
   previous_load_ = load;
   last_x_ = x;
   last_p1_ = p1;
@@ -186,7 +204,8 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
     const double ratio =
         temperature_seen_ && ratio_hops_ > 0 ? ratio_sum_ / static_cast<double>(ratio_hops_) : 1.0;
     b.t = t;
-    b.y = sum_flow_;
+    b.y_tau = sum_flows_;
+    if (tau_index_ != kTauNotChosen) set_chosen_flow(b);
     b.move = area * (last_x_ - start_x_) / flow_unit_;
     b.load = sum_load_ / rig.ps * ratio;
     const double v1e = v0 + area * last_x_, v2e = v0 - area * last_x_;
@@ -201,7 +220,8 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
   start_x_ = last_x_;
   start_p1_ = last_p1_;
   start_p2_ = last_p2_;
-  sum_flow_ = sum_load_ = block_length_ = ratio_sum_ = 0.0;
+  sum_flows_.fill(0.0);
+  sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
   if (!ok) {
     block_reason_ =
@@ -257,9 +277,9 @@ void FlowLawDetector::probe_learned_change() {
   const std::span<const Block> reference_blocks(
       learned_.data(), static_cast<std::size_t>(reference_end - learned_.begin()));
   if (!excited(reference_blocks)) return;
-  LeastSquares<4> fit;
+  LeastSquares<kRegressors> fit;
   for (const auto& b : reference_blocks) fit.add(regressors(b), b.y);
-  const Eigen::Vector4d reference = fit.solve();
+  const Coefficients reference = fit.solve();
   for (const auto& b : learned_) {
     probe_blocks_.push_back(
         {b.t - options_.block_seconds, b.t, b.y - reference.dot(regressors(b)), b.load});
@@ -271,8 +291,58 @@ void FlowLawDetector::probe_learned_change() {
   learned_change_ = find_slope_step(probe_blocks_, reference_blocks.size(), options);
 }
 
+// Every rung while the ladder is weighed; then the chosen one and, when its lag is fitted, its
+// neighbours for the slope between them.
+FlowLawDetector::Rungs FlowLawDetector::active_rungs() const {
+  if (tau_index_ == kTauNotChosen) return {0, kTauCandidates - 1};
+  if (!fit_lag_) return {tau_index_, tau_index_};
+  return {tau_index_ == 0 ? 0 : tau_index_ - 1, std::min(tau_index_ + 1, kTauCandidates - 1)};
+}
+
+// The block's flow with the chosen time constant, and its slope per rung of the ladder: the lag
+// regressor, which takes up the error between the rungs (linear in the logarithm of tau).
+void FlowLawDetector::set_chosen_flow(Block& b) const {
+  b.y = b.y_tau[tau_index_];
+  const Rungs rungs = active_rungs();
+  b.lag = rungs.last > rungs.first ? (b.y_tau[rungs.last] - b.y_tau[rungs.first]) /
+                                         static_cast<double>(rungs.last - rungs.first)
+                                   : 0.0;
+}
+
+// The rung whose fit over the learning blocks leaves the least squared residual (ties go to the
+// stated one); the blocks then keep its flow and slope.
+void FlowLawDetector::choose_spool_time_constant() {
+  if (tau_index_ == kTauNotChosen) {
+    double best = kMissing;
+    tau_index_ = kStatedTau;
+    for (std::size_t i = 0; i < kTauCandidates; ++i) {
+      LeastSquares<4> fit;
+      const auto without_lag = [](const Block& b) {
+        return Eigen::Vector4d(b.move, b.load, b.comp, b.length);
+      };
+      for (const auto& b : learned_) fit.add(without_lag(b), b.y_tau[i]);
+      const Eigen::Vector4d c = fit.solve();
+      double sum_sq = 0.0;
+      for (const auto& b : learned_) {
+        const double r = b.y_tau[i] - c.dot(without_lag(b));
+        sum_sq += r * r;
+      }
+      if (!(sum_sq >= best) || (i == kStatedTau && sum_sq <= best)) {
+        best = sum_sq;
+        tau_index_ = i;
+      }
+    }
+  }
+  for (auto& b : learned_) set_chosen_flow(b);
+}
+
+double FlowLawDetector::spool_time_constant() const {
+  return tau_index_ == kTauNotChosen ? kMissing : taus_[tau_index_];
+}
+
 void FlowLawDetector::finish_learning() {
-  LeastSquares<4> fit;
+  choose_spool_time_constant();
+  LeastSquares<kRegressors> fit;
   for (const auto& b : learned_) fit.add(regressors(b), b.y);
   coefficients_ = fit.solve();
   double sum_sq = 0.0, sum_lag = 0.0, previous = 0.0;
@@ -360,13 +430,27 @@ Decision FlowLawDetector::decide() const {
 }
 
 namespace {
-constexpr std::array<std::string_view, 4> kCoefficientNames = {"move", "load", "comp", "length"};
+constexpr std::array<std::string_view, 5> kCoefficientNames = {"move", "load", "comp", "length",
+                                                               "lag"};
+
+template <std::size_t N>
+void ladder(const DetectorState& state, std::string_view key, std::array<double, N>& values) {
+  const auto& list = state.get_list(key);
+  if (list.size() != N) throw StateError("'" + std::string(key) + "' has the wrong length");
+  std::copy(list.begin(), list.end(), values.begin());
 }
+}  // namespace
 
 DetectorState FlowLawDetector::export_state() const {
   DetectorState state(std::string(name()), kStateVersion);
   clock_.save(state, "learning");
   put_records(state, "learned", std::span<const Block>(learned_), block_fields());
+  std::vector<double> y_tau;
+  y_tau.reserve(learned_.size() * kTauCandidates);
+  for (const auto& b : learned_) y_tau.insert(y_tau.end(), b.y_tau.begin(), b.y_tau.end());
+  state.put("learned.y_tau", y_tau);
+  state.put("tau.index", tau_index_ == kTauNotChosen ? kMissing : static_cast<double>(tau_index_));
+  state.put("tau.fit_lag", fit_lag_ ? 1.0 : 0.0);
   for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
     state.put(state_key("coefficient", kCoefficientNames[i]),
               coefficients_[static_cast<Eigen::Index>(i)]);
@@ -379,10 +463,10 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("hop_usable", hop_usable_ ? 1.0 : 0.0);
   state.put("previous_x", previous_x_);
   state.put("sample_seconds", sample_seconds_);
-  state.put("spool.opening", opening_);
+  state.put("spool.openings", openings_);
   state.put("spool.previous_command", previous_command_);
   state.put("sample.have_previous", have_previous_ ? 1.0 : 0.0);
-  state.put("sample.flow", previous_flow_);
+  state.put("sample.flows", previous_flows_);
   state.put("sample.load", previous_load_);
   state.put("sample.x", last_x_);
   state.put("sample.p1", last_p1_);
@@ -392,7 +476,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("block.start_x", start_x_);
   state.put("block.start_p1", start_p1_);
   state.put("block.start_p2", start_p2_);
-  state.put("block.flow", sum_flow_);
+  state.put("block.flows", sum_flows_);
   state.put("block.load", sum_load_);
   state.put("block.length", block_length_);
   state.put("block.ratio_sum", ratio_sum_);
@@ -417,6 +501,24 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     }
     learned_.resize(learned);  // within the reserved capacity
     get_records(state, "learned", block_fields(), std::span<Block>(learned_));
+    const auto& y_tau = state.get_list("learned.y_tau");
+    if (y_tau.size() != learned * kTauCandidates) {
+      throw StateError("'learned.y_tau' does not hold the learned blocks' ladder");
+    }
+    for (std::size_t i = 0; i < learned; ++i) {
+      std::copy_n(y_tau.begin() + static_cast<std::ptrdiff_t>(i * kTauCandidates), kTauCandidates,
+                  learned_[i].y_tau.begin());
+    }
+    const double index = state.get("tau.index");
+    if (std::isnan(index)) {
+      tau_index_ = kTauNotChosen;
+    } else if (index >= 0.0 && index < static_cast<double>(kTauCandidates) &&
+               index == std::floor(index)) {
+      tau_index_ = static_cast<std::size_t>(index);
+    } else {
+      throw StateError("'tau.index' out of range");
+    }
+    fit_lag_ = state.get("tau.fit_lag") != 0.0;
     for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
       coefficients_[static_cast<Eigen::Index>(i)] =
           state.get(state_key("coefficient", kCoefficientNames[i]));
@@ -429,10 +531,10 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     hop_usable_ = state.get("hop_usable") != 0.0;
     previous_x_ = state.get("previous_x");
     sample_seconds_ = state.get("sample_seconds");
-    opening_ = state.get("spool.opening");
+    ladder(state, "spool.openings", openings_);
     previous_command_ = state.get("spool.previous_command");
     have_previous_ = state.get("sample.have_previous") != 0.0;
-    previous_flow_ = state.get("sample.flow");
+    ladder(state, "sample.flows", previous_flows_);
     previous_load_ = state.get("sample.load");
     last_x_ = state.get("sample.x");
     last_p1_ = state.get("sample.p1");
@@ -443,7 +545,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     start_x_ = state.get("block.start_x");
     start_p1_ = state.get("block.start_p1");
     start_p2_ = state.get("block.start_p2");
-    sum_flow_ = state.get("block.flow");
+    ladder(state, "block.flows", sum_flows_);
     sum_load_ = state.get("block.load");
     block_length_ = state.get("block.length");
     ratio_sum_ = state.get("block.ratio_sum");

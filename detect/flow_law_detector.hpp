@@ -14,6 +14,12 @@
 // A block whose mean |p1 - p2| stays below `min_load` carries no information and is not judged.
 // Laminar paths follow viscosity: with a `temp` observation the load term is scaled to 40 degC;
 // without, the healthy slope is followed by the shared drift reference behind a guard.
+// The spool's time constant is learned too (`learn_spool_time_constant`): valves on other rigs lag
+// 1-20 ms (MODEL.md "Other rigs"), and a lag stated wrong moves the flow of every step's opening
+// and closing into the neighbouring block, one block up and the next down, as the load swings
+// with the step: the pattern of a leak. While learning, the flow is integrated for a ladder of
+// time constants around the stated one; learning keeps the rung whose fit leaves the least, and a
+// fifth regressor, the flow's slope between the neighbouring rungs, takes up the rest.
 #pragma once
 
 #include <array>
@@ -57,6 +63,9 @@ struct FlowLawOptions {
   double drift_window_seconds = 120.0;
   double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers
   bool estimate_supply = true;
+  // Learn the spool's time constant from the learning blocks (a ladder of kTauCandidates values,
+  // a third of an octave apart around rig.tau); false keeps rig.tau.
+  bool learn_spool_time_constant = true;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -81,35 +90,58 @@ class FlowLawDetector final : public Detector {
   // The learning period is over but the loads seen so far do not identify the model (a hold
   // alone): waiting for excitation.
   bool waiting_for_excitation() const { return waiting_; }
-  // The learned coefficients [a, c, k, d] in normalised units (a = Kv_nominal / Kv_true).
-  Eigen::Vector4d coefficients() const { return coefficients_; }
+  static constexpr int kRegressors = 5;
+  using Coefficients = Eigen::Matrix<double, kRegressors, 1>;
+  // The learned coefficients [a, c, k, d, lag] in normalised units (a = Kv_nominal / Kv_true).
+  Coefficients coefficients() const { return coefficients_; }
   std::size_t blocks_not_judged_no_load() const { return no_load_blocks_; }
+  // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
+  // from the data); NaN while learning still weighs the ladder.
+  double spool_time_constant() const;
 
-  static constexpr int kStateVersion = 1;
+  // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept).
+  static constexpr int kStateVersion = 2;
+  // The ladder: rig.tau x 2^((i - kStatedTau) / 3), 1/8 to 8 times the stated value.
+  static constexpr std::size_t kTauCandidates = 19;
+  static constexpr std::size_t kStatedTau = 9;
+  static constexpr std::size_t kTauNotChosen = kTauCandidates;
 
  private:
   // One closed block, regressors in units of the valve's full flow Kv sqrt(ps) times seconds.
   struct Block {
     double t = kMissing;
-    double y = kMissing;          // int qL dt
+    double y = kMissing;          // int qL dt with the chosen time constant
     double move = kMissing;       // A dx
     double load = kMissing;       // int (p1 - p2) dt / ps (times the viscosity ratio with temp)
     double comp = kMissing;       // compressibility term / beta_nominal
     double length = kMissing;     // T
     double mean_load = kMissing;  // mean p1 - p2 [Pa]
+    double lag = kMissing;        // d int qL dt per rung of the time-constant ladder
+    std::array<double, kTauCandidates> y_tau{};  // int qL dt per rung (read while learning)
   };
-  static constexpr std::array<RecordField<Block>, 7> block_fields() {
+  static constexpr std::array<RecordField<Block>, 8> block_fields() {
     return {record_field<&Block::t>("t"),
             record_field<&Block::y>("y"),
             record_field<&Block::move>("move"),
             record_field<&Block::load>("load"),
             record_field<&Block::comp>("comp"),
             record_field<&Block::length>("length"),
-            record_field<&Block::mean_load>("mean_load")};
+            record_field<&Block::mean_load>("mean_load"),
+            record_field<&Block::lag>("lag")};
   }
-  static Eigen::Vector4d regressors(const Block& b) { return {b.move, b.load, b.comp, b.length}; }
+  static Coefficients regressors(const Block& b) {
+    return Coefficients(b.move, b.load, b.comp, b.length, b.lag);
+  }
   double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
 
+  // The rungs of the ladder integrated, first to last.
+  struct Rungs {
+    std::size_t first, last;
+  };
+  Rungs active_rungs() const;
+  void reset_spool_time_constant();
+  void set_chosen_flow(Block& b) const;
+  void choose_spool_time_constant();
   void restart_block();
   void add_sample(double u, double x, double p1, double p2);
   void close_block(double t, bool past_settling);
@@ -130,7 +162,7 @@ class FlowLawDetector final : public Detector {
   LearningClock clock_;
   std::vector<Block> learned_;  // reserved at construction; the newest when waiting
   std::size_t learn_capacity_;
-  Eigen::Vector4d coefficients_ = Eigen::Vector4d::Zero();
+  Coefficients coefficients_ = Coefficients::Zero();
   double block_sigma_ = kMissing;
   bool waiting_ = false;
   std::size_t no_load_blocks_ = 0;
@@ -144,16 +176,23 @@ class FlowLawDetector final : public Detector {
   bool hop_usable_ = false;
   double sample_seconds_ = kMissing;
   double previous_x_ = kMissing;  // hop mean, for the rest test of the supply estimate
-  // Per sample: the spool (exact zero-order-hold lag) and the previous sample.
-  double opening_ = kMissing, previous_command_ = kMissing;
+  // The time-constant ladder: kTauNotChosen while every candidate is integrated.
+  std::array<double, kTauCandidates> taus_{};
+  std::size_t tau_index_ = kTauNotChosen;
+  bool fit_lag_ = true;  // false: the chosen rung's flow alone (not learned, or an old layout)
+  // Per sample and candidate: the spool (exact zero-order-hold lag) and the previous flow.
+  std::array<double, kTauCandidates> openings_{};
+  std::array<double, kTauCandidates> previous_flows_{};
+  double previous_command_ = kMissing;
   bool have_previous_ = false;
-  double previous_flow_ = 0.0, previous_load_ = 0.0;
+  double previous_load_ = 0.0;
   double last_x_ = 0.0, last_p1_ = 0.0, last_p2_ = 0.0;
   // The current block.
   std::size_t block_hop_ = 0;
   bool block_ok_ = false;
   double start_x_ = 0.0, start_p1_ = 0.0, start_p2_ = 0.0;
-  double sum_flow_ = 0.0, sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
+  std::array<double, kTauCandidates> sum_flows_{};
+  double sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
   std::size_t ratio_hops_ = 0;
   // The added slope on the load term: exponentially weighted, and since the CUSUM left zero.
   struct SlopeSums {

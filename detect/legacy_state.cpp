@@ -1,6 +1,7 @@
 #include "detect/legacy_state.hpp"
 
 #include "detect/feature_test.hpp"
+#include "detect/flow_law_detector.hpp"
 
 #include <cmath>
 #include <initializer_list>
@@ -135,6 +136,34 @@ DetectorState flow_from_3(const DetectorState& old) {
   out.put("excitation.cannot_learn", 0.0);
   out.put("judging.last_judged_t", kNaN);
   out.put("judging.reason", static_cast<double>(NotJudgedReason::in_motion));
+  return out;
+}
+
+// flow_law 1 integrated the flow with the stated spool time constant only: layout 2's ladder
+// with that one chosen (every candidate holds its values, only the chosen is read again).
+DetectorState flow_law_from_1(const DetectorState& old) {
+  constexpr std::size_t kCandidates = FlowLawDetector::kTauCandidates;
+  DetectorState out(old.kind(), 2);
+  for (const auto& entry : old.entries()) {
+    if (entry.first != "spool.opening" && entry.first != "sample.flow" &&
+        entry.first != "block.flow") {
+      out.put(entry.first, entry.second);
+    }
+  }
+  const auto ladder = [&](std::string_view from, std::string_view to) {
+    const std::vector<double> values(kCandidates, old.get(from));
+    out.put(to, values);
+  };
+  ladder("spool.opening", "spool.openings");
+  ladder("sample.flow", "sample.flows");
+  ladder("block.flow", "block.flows");
+  std::vector<double> y_tau;
+  for (const double y : old.get_list("learned.y")) y_tau.insert(y_tau.end(), kCandidates, y);
+  out.put("learned.y_tau", y_tau);
+  out.put("tau.index", static_cast<double>(FlowLawDetector::kStatedTau));
+  out.put("tau.fit_lag", 0.0);
+  out.put("coefficient.lag", 0.0);
+  out.put("learned.lag", std::vector<double>(old.get_list("learned.y").size(), 0.0));
   return out;
 }
 
@@ -302,6 +331,7 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_issue_26(state, 3, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() == 1 && version == 2) return flow_law_from_1(state);
     if (kind == "detail_xcorr" && state.version() == 1 && version == 2) return xcorr_from_1(state);
   }
   state.expect(kind, version);  // throws: another kind, or a layout not read here

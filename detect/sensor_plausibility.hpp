@@ -50,7 +50,10 @@ struct PlausibilityLimits {
   std::uint32_t spike_quiet = 0;  // "spikes" from a rejected spike until this many quiet samples
   std::uint32_t recovery = 0;     // fault-free samples before the status returns to ok
   double spike_sigma = 0.0;       // Hampel threshold floor [channel unit]
-  bool zero_is_dropout = false;   // 0 is the bottom of the range: exact zeros mean no signal
+  double deviation_noise = 0.0;   // mean |sample - neighbours' median| of the noise alone
+  double deviation_memory = 0.0;  // weight of each sample in the channel's deviation scale
+  std::uint32_t deviation_warmup = 0;  // samples before a rejected sample is named a spike
+  bool zero_is_dropout = false;        // 0 is the bottom of the range: exact zeros mean no signal
 };
 
 PlausibilityLimits plausibility_limits(const TransducerSpec& spec, double sample_rate_hz);
@@ -98,6 +101,8 @@ class SensorPlausibility {
   std::uint32_t zero_run_ = 0;        // consecutive exact zeros (when zero_is_dropout)
   std::uint32_t nan_run_ = 0;
   std::uint64_t last_spike_ = 0;  // sample number of the last rejected spike; 0: none
+  // The channel's own mean deviation from its neighbours' median (rejected samples left out).
+  double deviation_scale_ = 0.0;
   std::uint64_t spikes_rejected_ = 0;
 
   SensorFault active_ = SensorFault::none;

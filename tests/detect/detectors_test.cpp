@@ -109,6 +109,7 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
                                   "valve_coefficient",
                                   "piston_area",
                                   "spool_time_constant",
+                                  "learn_spool_time_constant",
                                   "min_load_spread",
                                   "min_load",
                                   "design_leak",
