@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unsupported/Eigen/LevenbergMarquardt>
 
 namespace leakmon::model {
@@ -188,6 +189,28 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
   }
   result.evaluations = problem.evaluations();
   return result;
+}
+
+Calibration best_beta_on_grid(const SegmentPredictor& predictor, std::span<const Segment> segments,
+                              const Calibration& start, const Calibration& stated,
+                              double relative_step) {
+  const auto [lower, upper] = calibration_bounds(stated);
+  std::vector<double> residuals(SegmentPredictor::residual_count(segments));
+  ModelParameters p;
+  p.calibration = start;
+  Calibration best = start;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (double beta = lower.beta; beta <= upper.beta; beta *= 1.0 + relative_step) {
+    p.calibration.beta = beta;
+    predictor.residuals(p, segments, residuals);
+    double cost = 0.0;
+    for (const double r : residuals) cost += r * r;
+    if (cost < best_cost) {
+      best_cost = cost;
+      best.beta = beta;
+    }
+  }
+  return best;
 }
 
 std::vector<std::string> calibration_at_bound(const Calibration& c, const Calibration& stated,

@@ -40,6 +40,15 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
                     const EffectCandidate* candidate, const Calibration& start,
                     const FitSettings& settings = {});
 
+// `start` with beta replaced by the value on a geometric grid across beta's bounds (steps of
+// `relative_step`) whose model fits `segments` best, the others held. A lightly damped
+// hydraulic mode rung in the data is matched only within a few per cent of its frequency
+// (sqrt(beta)); from further away the fit damps the mode instead (b to its bound), and beta
+// then has no gradient left to follow (docs/model-check.md, seed 770009).
+Calibration best_beta_on_grid(const SegmentPredictor& predictor, std::span<const Segment> segments,
+                              const Calibration& start, const Calibration& stated = {},
+                              double relative_step = 0.02);
+
 // The calibratable parameters (beta, Kv, m, b) that sit on the bound the fit holds them to
 // (within `tolerance` of the bound interval's width): such a value is not a calibration but a
 // sign that the model is compensating for something it lacks.

@@ -1,8 +1,9 @@
 // Issue 24 end to end: the model check on other rigs told their description, on descriptions
 // with one value stated wrong, and on effects that start inside the capture; the JSON of
-// FORMATS.md for each. Every run draws fresh rigs and cases (seeds printed; LEAKMON_TEST_SEED
-// reproduces a run). Quorums come from the per-draw rates `leakmon model evaluate --rigs
-// other` measured (docs/model-check.md, "Other rigs"), not from hope.
+// FORMATS.md for each. Most tests draw fresh rigs and cases each run (seeds printed;
+// LEAKMON_TEST_SEED reproduces a run), with quorums from the per-draw rates `leakmon model
+// evaluate --rigs other` measured (docs/model-check.md, "Other rigs"), not from hope; the
+// others run fixed cases of those evaluations.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "model/diagnosis.hpp"
+#include "model/evaluation.hpp"
 #include "model/result_json.hpp"
 #include "model/synthetic_case.hpp"
 #include "tests/model/test_seed.hpp"
@@ -155,27 +157,59 @@ TEST(RippleLine, NeverNamedAheadOfAStrongerEffect) {
 }
 
 // A library effect hidden on another rig told its description is found, and found alone: no
-// second effect next to it, no rig_parameter. Three fresh rigs, one effect each among the
-// leak, the valve bias and the dead band (effects whose size is certain on any rig); the
-// evaluation named one library effect alone in 70-80 % of draws (docs/model-check.md), so
-// none of three alone happens about once in 100 runs.
+// second effect next to it, no rig_parameter, its main parameter within 25 %. One case each of
+// the leak, the valve bias and the dead band (effects whose size is certain on any rig).
+// Fixed cases by default, so that CI cannot flake: the first of each effect in a fresh
+// `model evaluate --rigs other --classes library --seed 782000` run (180 s; all three named
+// alone there). Drawn afresh each run this test failed in about 1 run in 100 (seed
+// 253715682021678798: a leak the capture does not show, a bias on a 106 kg rig whose
+// calibration stays far above the true model, a dead band named with entrained air;
+// docs/model-check.md). LEAKMON_TEST_SEED=S draws three fresh cases S, S+1, S+2 to explore;
+// a drawn effect the capture does not show (the calibrated nominal model already predicts the
+// held-out data within 10 % of the generator's true model: nothing is left to name, docs'
+// "the capture does not show it") is reported and left out, every other one must pass.
 TEST(OtherRig, HiddenEffectIsNamedAlone) {
-  const auto seed = test::model_test_seed("OtherRig.HiddenEffectIsNamedAlone");
   const char* effects[] = {"internal_leakage", "valve_bias", "valve_overlap"};
-  int alone = 0;
-  for (std::uint64_t i = 0; i < 3; ++i) {
-    const SyntheticCase c = draw_case(seed + i, effects[i], other_rig(120.0));
-    const Diagnosis d = diagnose_case(c);
-    std::printf("  seed %llu: %s %s true %.4g\n", static_cast<unsigned long long>(seed + i),
-                effects[i], c.main_parameter.c_str(), c.main_value);
-    EXPECT_TRUE(d.rig_check.findings.empty()) << "seed " << seed + i;
-    if (d.causes.size() == 1 && d.causes.front().effect == effects[i] &&
-        std::abs(d.causes.front().params.front().value - c.main_value) <=
-            0.25 * std::abs(c.main_value)) {
-      ++alone;
-    }
+  std::uint64_t seeds[] = {782000, 782005, 782004};
+  if (std::getenv("LEAKMON_TEST_SEED")) {
+    const auto first = test::model_test_seed("OtherRig.HiddenEffectIsNamedAlone");
+    for (std::uint64_t i = 0; i < 3; ++i) seeds[i] = first + i;
   }
-  EXPECT_GE(alone, 1);
+  int shown = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const CaseOutcome o = evaluate_case(seeds[i], effects[i], other_rig(180.0));
+    std::printf(
+        "  seed %llu: %s %s true %.4g est %.4g -> [%s]; NRMSE %.4f -> %.4f, true model "
+        "%.4f, floor %.4f; %s\n",
+        static_cast<unsigned long long>(seeds[i]), effects[i], o.main_parameter.c_str(),
+        o.true_value, o.estimate, o.causes.c_str(), o.nrmse_before, o.nrmse_after, o.nrmse_true,
+        o.nrmse_floor, o.rig.c_str());
+    EXPECT_TRUE(o.rig_findings.empty()) << "seed " << seeds[i];
+    if (o.nrmse_before <= 1.1 * o.nrmse_true) {
+      std::printf("  seed %llu: the capture does not show the %s; left out\n",
+                  static_cast<unsigned long long>(seeds[i]), effects[i]);
+      continue;
+    }
+    ++shown;
+    EXPECT_TRUE(o.only_truth_named()) << "seed " << seeds[i] << ": " << o.causes;
+    EXPECT_TRUE(o.parameter_within(0.25))
+        << "seed " << seeds[i] << ": " << o.estimate << " for " << o.true_value;
+  }
+  EXPECT_GE(shown, 1) << "no drawn effect shows in its capture: draw others";
+}
+
+// Healthy rig 770009 of `model evaluate --rigs other --classes clean` (59 mm, 20 kg, a slow
+// 18.8 ms spool, the stated beta 15 % below the true one): its lightly damped hydraulic mode,
+// rung in the pressures, is matched only by a beta within a few per cent of the true one.
+// From every start the fit damped the mode out instead (b on its upper bound) and stopped at
+// 1.2 x the true model's held-out error (`unexplained`); beta is now scanned on a grid when
+// the nominal calibration ends on a bound (model/calibration_fit.hpp, best_beta_on_grid).
+TEST(OtherRig, LightlyDampedModeIsMatchedNotDampedOut) {
+  const CaseOutcome o = evaluate_case(770009, "none", other_rig(180.0));
+  std::printf("  770009: -> %s; NRMSE %.4f, true model %.4f, floor %.4f; %s\n", o.named.c_str(),
+              o.nrmse_before, o.nrmse_true, o.nrmse_floor, o.rig.c_str());
+  EXPECT_EQ(o.named, "none") << o.causes;
+  EXPECT_LT(o.nrmse_before, 1.05 * o.nrmse_true);
 }
 
 // A healthy rig whose own lightly damped hydraulic mode, rung by the spool flow noise, shows
