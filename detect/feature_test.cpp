@@ -319,6 +319,19 @@ bool FeatureTest::runs_outside() const {
 // throughout, a sine or a triangle moves at one steady pace. The regressors of the feature's
 // model are identified only in the first case (a hold makes the load and the activity
 // constants), and the steady programs the regime test recognises against it.
+bool FeatureTest::one_program_so_far() const {
+  if (!waits_for_excitation_ || !(options_.min_excitation_range > 0.0)) return true;
+  if (static_cast<double>(learning_rest_run_) * hop_seconds() > kLongestLearningRestSeconds) {
+    return false;
+  }
+  if (learned_.size() < kRegimeBlocks) return true;
+  double sum = 0.0;
+  for (std::size_t age = 0; age < kRegimeBlocks; ++age) {
+    sum += learned_[learned_.size() - 1 - age].rest_share;
+  }
+  return !(sum < kLearningRestShare * static_cast<double>(kRegimeBlocks));
+}
+
 bool FeatureTest::excited_enough() {
   if (!waits_for_excitation_ || !(options_.min_excitation_range > 0.0)) return true;
   scratch_.clear();
@@ -412,8 +425,12 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
       learning_rest_run_ = std::max(learning_rest_run_, completed_rest_run_);
       learning_motion_run_ = std::max(learning_motion_run_, completed_motion_run_);
     }
-    if (clock_.period_over()) {
-      if (excited_enough()) {
+    const bool over = clock_.period_over();
+    // A hold or another program within the period: discarded at once, so that the next period
+    // begins with the program that follows rather than up to a period later.
+    const bool broken = completed && !over && !one_program_so_far();
+    if (over || broken) {
+      if (over && excited_enough()) {
         finish_learning();
       } else if (excitation_wait_seconds_ >= options_.max_excitation_wait_seconds) {
         // A baseline of an unexcited rig would read the first excited program as a leak.
@@ -421,7 +438,9 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
         learned_.clear();
         clock_.set_learned();
       } else {
-        excitation_wait_seconds_ += options_.learning.learn_seconds;
+        excitation_wait_seconds_ +=
+            over ? options_.learning.learn_seconds
+                 : static_cast<double>(clock_.learning_hop() + 1) * hop_seconds();
         learned_.clear();
         learning_rest_run_ = learning_motion_run_ = 0;
         clock_.restart_period();

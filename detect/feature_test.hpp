@@ -42,9 +42,10 @@
 //   regime: a hold after about twice the steps' longest level, a sine within a second or two.
 // - For the same reason a learning period must be one such program: every kRegimeBlocks
 //   window rests for at least kLearningRestShare of its hops and no rest run is longer than
-//   kLongestLearningRestSeconds (a hold, or a sine or sweep, within the period is discarded
-//   like an unexcited one). A period learned across a program change took both programs' rest
-//   shares as its regime and judged either by one model.
+//   kLongestLearningRestSeconds. A period that breaks either is discarded at the block that
+//   shows it (not at its end), so the next period begins with the program that follows. A
+//   period learned across a program change took both programs' rest shares as its regime and
+//   judged either by one model. min_excitation_range 0 switches these checks off as well.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -181,6 +182,8 @@ class FeatureTest {
                     Block& completed);
   // At the end of a learning period: whether its blocks show the mode ringing.
   bool excited_enough();
+  // While learning, after each block: no hold and no window that hardly rests so far.
+  bool one_program_so_far() const;
   // Whether the block lies outside the learned regime (it joins the regime ring).
   bool outside_regime(const Block& block);
   // Whether the block's longest rest or motion run exceeds what the learning period saw.
