@@ -133,7 +133,7 @@ class FeatureTest {
   static constexpr double kRunFactor = 2.0;
   static constexpr double kMotionRunSlackSeconds = 0.2;
   // What a learning period must show to be one program that moves and rests (the file comment).
-  static constexpr double kLearningRestShare = 0.5;
+  static constexpr double kLearningRestShare = 0.3;
   static constexpr double kLongestLearningRestSeconds = 20.0;
   // One hop: `feature` over the window that ended at o.t (NaN: a gap; nothing is judged then),
   // with the observation's pressures (and its temperature when the physics uses it).
