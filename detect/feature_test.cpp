@@ -79,6 +79,9 @@ void FeatureTest::reset() {
   learned_rest_low_ = learned_rest_high_ = kMissing;
   regime_.clear();
   outside_ = false;
+  learned_longest_rest_ = learned_longest_motion_ = kMissing;
+  rest_run_ = motion_run_ = block_rest_run_ = block_motion_run_ = 0;
+  completed_rest_run_ = completed_motion_run_ = learning_rest_run_ = learning_motion_run_ = 0;
   excitation_wait_seconds_ = 0.0;
   cannot_learn_ = false;
   waits_for_excitation_ = true;
@@ -103,6 +106,7 @@ void FeatureTest::resume_after_gap() {
   // The regime's blocks are on the old clock too (their residuals never reach the reference).
   regime_.clear();
   outside_ = false;
+  rest_run_ = motion_run_ = block_rest_run_ = block_motion_run_ = 0;
 }
 
 // Load pressure p1 - p2 over supply; with one chamber, that chamber's departure from mid-supply
@@ -173,6 +177,7 @@ bool FeatureTest::add_to_block(const Observation& o, double temp, double feature
                                double supply, Block& completed) {
   const double activity = std::abs(load - previous_load_);
   previous_load_ = load;
+  if (!std::isnan(activity)) count_run(activity < kRestActivity);
   const bool settled = supply_.settled(o.t) && !chamber_supply_.awaiting();
   const bool temperature_ok = !temperature_seen_ || !std::isnan(temp);
   if (!std::isnan(feature) && !std::isnan(activity) && settled && temperature_ok) {
@@ -201,6 +206,11 @@ bool FeatureTest::add_to_block(const Observation& o, double temp, double feature
                  sum_log_supply_ / n,
                  static_cast<double>(rest_hops_) / n};
   }
+  completed_rest_run_ = block_rest_run_;
+  completed_motion_run_ = block_motion_run_;
+  // A run that goes on reaches into the next block.
+  block_rest_run_ = rest_run_;
+  block_motion_run_ = motion_run_;
   block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
@@ -280,6 +290,28 @@ void FeatureTest::finish_learning() {
   }
   learned_rest_low_ = low;
   learned_rest_high_ = high;
+  learned_longest_rest_ = static_cast<double>(learning_rest_run_) * hop_seconds();
+  learned_longest_motion_ = static_cast<double>(learning_motion_run_) * hop_seconds();
+}
+
+void FeatureTest::count_run(bool at_rest) {
+  if (at_rest) {
+    ++rest_run_;
+    motion_run_ = 0;
+  } else {
+    ++motion_run_;
+    rest_run_ = 0;
+  }
+  block_rest_run_ = std::max(block_rest_run_, rest_run_);
+  block_motion_run_ = std::max(block_motion_run_, motion_run_);
+}
+
+bool FeatureTest::runs_outside() const {
+  if (!runs_known()) return false;
+  const double rest = static_cast<double>(completed_rest_run_) * hop_seconds();
+  const double motion = static_cast<double>(completed_motion_run_) * hop_seconds();
+  return rest > kRunFactor * learned_longest_rest_ ||
+         motion > kRunFactor * learned_longest_motion_ + kMotionRunSlackSeconds;
 }
 
 // The spread of the learning period's block log load activity (10 % to 90 % quantile): a
@@ -287,6 +319,19 @@ void FeatureTest::finish_learning() {
 // throughout, a sine or a triangle moves at one steady pace. The regressors of the feature's
 // model are identified only in the first case (a hold makes the load and the activity
 // constants), and the steady programs the regime test recognises against it.
+bool FeatureTest::one_program_so_far() const {
+  if (!waits_for_excitation_ || !(options_.min_excitation_range > 0.0)) return true;
+  if (static_cast<double>(learning_rest_run_) * hop_seconds() > kLongestLearningRestSeconds) {
+    return false;
+  }
+  if (learned_.size() < kRegimeBlocks) return true;
+  double sum = 0.0;
+  for (std::size_t age = 0; age < kRegimeBlocks; ++age) {
+    sum += learned_[learned_.size() - 1 - age].rest_share;
+  }
+  return !(sum < kLearningRestShare * static_cast<double>(kRegimeBlocks));
+}
+
 bool FeatureTest::excited_enough() {
   if (!waits_for_excitation_ || !(options_.min_excitation_range > 0.0)) return true;
   scratch_.clear();
@@ -298,7 +343,22 @@ bool FeatureTest::excited_enough() {
     return scratch_[static_cast<std::size_t>(k)];
   };
   const double low = at(0.1), high = at(0.9);
-  return high - low >= options_.min_excitation_range;
+  if (high - low < options_.min_excitation_range) return false;
+  // One program that moves and rests: no hold within the period, and no window of it (a sine,
+  // a sweep) that hardly rests.
+  if (static_cast<double>(learning_rest_run_) * hop_seconds() > kLongestLearningRestSeconds) {
+    return false;
+  }
+  if (learned_.size() < kRegimeBlocks) return true;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < learned_.size(); ++i) {
+    sum += learned_[i].rest_share;
+    if (i >= kRegimeBlocks) sum -= learned_[i - kRegimeBlocks].rest_share;
+    if (i + 1 >= kRegimeBlocks && sum < kLearningRestShare * static_cast<double>(kRegimeBlocks)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 // The share of hops at rest over the last kRegimeBlocks blocks against the learned range,
@@ -312,14 +372,18 @@ bool FeatureTest::outside_regime(const Block& block) {
     drift_.add(regime_.oldest().t, regime_.oldest().residual);
   }
   regime_.push({block.t, block.rest_share, kMissing});
-  if (!regime_.full()) return outside_;  // after a gap: too few blocks to say
-  double sum = 0.0;
-  for (std::size_t i = 0; i < regime_.size(); ++i) sum += regime_.oldest(i).share;
-  const double share = sum / static_cast<double>(regime_.size());
-  // Back in the regime only well inside: a program near the edge would otherwise flicker in
-  // and out, judged by halves.
-  const double margin = outside_ ? 0.5 * options_.regime_tolerance : options_.regime_tolerance;
-  const bool outside = share < learned_rest_low_ - margin || share > learned_rest_high_ + margin;
+  bool outside = outside_;  // after a gap: too few blocks to say from the share
+  if (regime_.full()) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < regime_.size(); ++i) sum += regime_.oldest(i).share;
+    const double share = sum / static_cast<double>(regime_.size());
+    // Back in the regime only well inside: a program near the edge would otherwise flicker in
+    // and out, judged by halves.
+    const double margin = outside_ ? 0.5 * options_.regime_tolerance : options_.regime_tolerance;
+    outside = share < learned_rest_low_ - margin || share > learned_rest_high_ + margin;
+  }
+  // A run longer than the program learned says the change before the share does.
+  outside = outside || runs_outside();
   if (outside && !outside_) {
     cusum_.take_back_after(regime_.oldest().t - 0.5 * options_.block_seconds);
     // The ring's blocks were judged in the new program: none of them enters the reference.
@@ -356,9 +420,17 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
   Block block{};
   const bool completed = add_to_block(o, temp, feature, load_of(o, supply), supply, block);
   if (!clock_.learned()) {
-    if (completed) learned_.push_back(block);  // capacity reserved: never reallocates
-    if (clock_.period_over()) {
-      if (excited_enough()) {
+    if (completed) {
+      learned_.push_back(block);  // capacity reserved: never reallocates
+      learning_rest_run_ = std::max(learning_rest_run_, completed_rest_run_);
+      learning_motion_run_ = std::max(learning_motion_run_, completed_motion_run_);
+    }
+    const bool over = clock_.period_over();
+    // A hold or another program within the period: discarded at once, so that the next period
+    // begins with the program that follows rather than up to a period later.
+    const bool broken = completed && !over && !one_program_so_far();
+    if (over || broken) {
+      if (over && excited_enough()) {
         finish_learning();
       } else if (excitation_wait_seconds_ >= options_.max_excitation_wait_seconds) {
         // A baseline of an unexcited rig would read the first excited program as a leak.
@@ -366,8 +438,11 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
         learned_.clear();
         clock_.set_learned();
       } else {
-        excitation_wait_seconds_ += options_.learning.learn_seconds;
+        excitation_wait_seconds_ +=
+            over ? options_.learning.learn_seconds
+                 : static_cast<double>(clock_.learning_hop() + 1) * hop_seconds();
         learned_.clear();
+        learning_rest_run_ = learning_motion_run_ = 0;
         clock_.restart_period();
         verdict.learning_hops_left = clock_.hops_left();
       }
@@ -426,6 +501,14 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
   state.put(key("regime.rest_high"), learned_rest_high_);
   save_ring(state, key("regime.blocks"), regime_, kRegimeFields);
   state.put(key("regime.outside"), outside_ ? 1.0 : 0.0);
+  state.put(key("regime.longest_rest"), learned_longest_rest_);
+  state.put(key("regime.longest_motion"), learned_longest_motion_);
+  state.put_count(key("run.rest_hops"), rest_run_);
+  state.put_count(key("run.motion_hops"), motion_run_);
+  state.put_count(key("block.rest_run"), block_rest_run_);
+  state.put_count(key("block.motion_run"), block_motion_run_);
+  state.put_count(key("excitation.rest_run"), learning_rest_run_);
+  state.put_count(key("excitation.motion_run"), learning_motion_run_);
   state.put(key("excitation.wait_seconds"), excitation_wait_seconds_);
   state.put(key("excitation.cannot_learn"), cannot_learn_ ? 1.0 : 0.0);
   state.put(key("excitation.waits"), waits_for_excitation_ ? 1.0 : 0.0);
@@ -468,6 +551,14 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
   learned_rest_high_ = state.get(key("regime.rest_high"));
   restore_ring(state, key("regime.blocks"), regime_, kRegimeFields);
   outside_ = state.get(key("regime.outside")) != 0.0;
+  learned_longest_rest_ = state.get(key("regime.longest_rest"));
+  learned_longest_motion_ = state.get(key("regime.longest_motion"));
+  rest_run_ = state.get_count(key("run.rest_hops"));
+  motion_run_ = state.get_count(key("run.motion_hops"));
+  block_rest_run_ = state.get_count(key("block.rest_run"));
+  block_motion_run_ = state.get_count(key("block.motion_run"));
+  learning_rest_run_ = state.get_count(key("excitation.rest_run"));
+  learning_motion_run_ = state.get_count(key("excitation.motion_run"));
   excitation_wait_seconds_ = state.get(key("excitation.wait_seconds"));
   cannot_learn_ = state.get(key("excitation.cannot_learn")) != 0.0;
   waits_for_excitation_ = state.get(key("excitation.waits")) != 0.0;

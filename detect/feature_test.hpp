@@ -34,6 +34,18 @@
 //   drift reference, and the blocks since the excursion began are taken back out of both. The
 //   feature's model (learned on steps) does not hold there: a 0.5 Hz sine rings the mode less,
 //   which read as a leak.
+// - The share over kRegimeBlocks blocks is slow to see a program change (and blind to a hold
+//   after steps, which rest most of the time too), so the runs of hops at rest and in motion
+//   are read as well: steps hold a level for at most a few seconds and move for a fraction of
+//   one. A block whose rest run or motion run exceeds kRunFactor times the longest the
+//   learning period saw (plus kMotionRunSlackSeconds for a motion) is outside the learned
+//   regime: a hold after about twice the steps' longest level, a sine within a second or two.
+// - For the same reason a learning period must be one such program: every kRegimeBlocks
+//   window rests for at least kLearningRestShare of its hops and no rest run is longer than
+//   kLongestLearningRestSeconds. A period that breaks either is discarded at the block that
+//   shows it (not at its end), so the next period begins with the program that follows. A
+//   period learned across a program change took both programs' rest shares as its regime and
+//   judged either by one model. min_excitation_range 0 switches these checks off as well.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -115,6 +127,14 @@ class FeatureTest {
   };
   // Blocks whose rest shares are averaged for the regime test.
   static constexpr std::size_t kRegimeBlocks = 8;
+  // The run test (see the file comment): how much longer than the learning period's longest
+  // rest or motion run a run may last in the learned regime, and the motion's slack (steps
+  // move for 0.3-0.5 s; a run a hop or two longer is still a step).
+  static constexpr double kRunFactor = 2.0;
+  static constexpr double kMotionRunSlackSeconds = 0.2;
+  // What a learning period must show to be one program that moves and rests (the file comment).
+  static constexpr double kLearningRestShare = 0.3;
+  static constexpr double kLongestLearningRestSeconds = 20.0;
   // One hop: `feature` over the window that ended at o.t (NaN: a gap; nothing is judged then),
   // with the observation's pressures (and its temperature when the physics uses it).
   Verdict update(const Observation& o, double feature);
@@ -162,10 +182,18 @@ class FeatureTest {
                     Block& completed);
   // At the end of a learning period: whether its blocks show the mode ringing.
   bool excited_enough();
+  // While learning, after each block: no hold and no window that hardly rests so far.
+  bool one_program_so_far() const;
   // Whether the block lies outside the learned regime (it joins the regime ring).
   bool outside_regime(const Block& block);
+  // Whether the block's longest rest or motion run exceeds what the learning period saw.
+  bool runs_outside() const;
+  // The rest and motion runs: one hop whose load activity is known.
+  void count_run(bool at_rest);
+  double hop_seconds() const { return options_.block_seconds / static_cast<double>(block_hops_); }
   void add_to_reference(const Block& block, double residual);
   bool regime_known() const { return !std::isnan(learned_rest_low_); }
+  bool runs_known() const { return !std::isnan(learned_longest_rest_); }
   double supply_for(const Observation& o, double load);
   double supply_from_chamber(const Observation& o, double load);
   void finish_learning();
@@ -182,6 +210,16 @@ class FeatureTest {
   // then every block is judged).
   double learned_rest_low_ = kMissing, learned_rest_high_ = kMissing;
   bool outside_ = false;
+  // The longest rest and motion runs [s] of the learning period; NaN when not learned (a state
+  // from before the run test: then only the rest share tells the regime).
+  double learned_longest_rest_ = kMissing, learned_longest_motion_ = kMissing;
+  // The current runs of hops at rest and in motion, the longest of each that ended in (or
+  // reached into) the block being filled, that of the last completed block, and the longest over
+  // the learning period so far (all in hops).
+  std::size_t rest_run_ = 0, motion_run_ = 0;
+  std::size_t block_rest_run_ = 0, block_motion_run_ = 0;
+  std::size_t completed_rest_run_ = 0, completed_motion_run_ = 0;
+  std::size_t learning_rest_run_ = 0, learning_motion_run_ = 0;
   double excitation_wait_seconds_ = 0.0;  // learning periods discarded for want of excitation
   bool cannot_learn_ = false;
   // Whether learning waits for excitation; off for a state from a build before it.

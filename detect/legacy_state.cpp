@@ -307,6 +307,22 @@ DetectorState feature_test_from_issue_26(const DetectorState& old, int version,
   return c.out();
 }
 
+// The feature test before the run test (index_cusum 5, detail_xcorr 3): no learned runs, so
+// the converted test tells the regime by the rest share alone, as that build did.
+DetectorState feature_test_from_rest_share(const DetectorState& old, int version,
+                                           std::string_view prefix) {
+  Conversion c(old, version);
+  for (const auto& [key, values] : old.entries()) c.put(key, values);
+  const auto key = [prefix](std::string_view name) { return state_key(prefix, name); };
+  c.put(key("regime.longest_rest"), kNaN);
+  c.put(key("regime.longest_motion"), kNaN);
+  for (const char* count : {"run.rest_hops", "run.motion_hops", "block.rest_run",
+                            "block.motion_run", "excitation.rest_run", "excitation.motion_run"}) {
+    c.out().put_count(key(count), 0);
+  }
+  return c.out();
+}
+
 }  // namespace
 
 DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
@@ -318,17 +334,25 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
     }
     if (kind == "flow_balance" && state.version() == 3 && version == 4) return flow_from_3(state);
     if (kind == "index_cusum" && state.version() == 3 && version == 4) return index_from_3(state);
-    if (kind == "index_cusum" && state.version() == 3 && version == 5) {
-      return feature_test_from_issue_26(index_from_3(state), 5, "");
+    if (kind == "index_cusum" && state.version() == 3 && version == 6) {
+      return feature_test_from_rest_share(feature_test_from_issue_26(index_from_3(state), 5, ""), 6,
+                                          "");
     }
-    if (kind == "index_cusum" && state.version() == 4 && version == 5) {
-      return feature_test_from_issue_26(state, 5, "");
+    if (kind == "index_cusum" && state.version() == 4 && version == 6) {
+      return feature_test_from_rest_share(feature_test_from_issue_26(state, 5, ""), 6, "");
     }
-    if (kind == "detail_xcorr" && state.version() == 1 && version == 3) {
-      return feature_test_from_issue_26(xcorr_from_1(state), 3, "test");
+    if (kind == "index_cusum" && state.version() == 5 && version == 6) {
+      return feature_test_from_rest_share(state, 6, "");
     }
-    if (kind == "detail_xcorr" && state.version() == 2 && version == 3) {
-      return feature_test_from_issue_26(state, 3, "test");
+    if (kind == "detail_xcorr" && state.version() == 1 && version == 4) {
+      return feature_test_from_rest_share(
+          feature_test_from_issue_26(xcorr_from_1(state), 3, "test"), 4, "test");
+    }
+    if (kind == "detail_xcorr" && state.version() == 2 && version == 4) {
+      return feature_test_from_rest_share(feature_test_from_issue_26(state, 3, "test"), 4, "test");
+    }
+    if (kind == "detail_xcorr" && state.version() == 3 && version == 4) {
+      return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
     if (kind == "flow_law" && state.version() == 1 && version == 2) return flow_law_from_1(state);

@@ -6,7 +6,9 @@
 //   flow_law 1 (before it learned the spool's time constant: loaded with the stated one kept);
 //   fused 1 is unchanged (its members' states carry their own layouts); and index_cusum 4 and
 //   detail_xcorr 2, written before the feature test waited for excitation and judged in the
-//   learned regime only (issue 23): converted with neither (they judge as they did until reset).
+//   learned regime only (issue 23): converted with neither (they judge as they did until reset);
+//   index_cusum 5 and detail_xcorr 3, written before the regime test read the rest and motion
+//   runs: converted without the learned runs (the rest share alone tells the regime, as then).
 // The conversion renames and splits lists; it computes nothing, so a converted state decides
 // exactly as the old build would have.
 #pragma once

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <memory>
+#include <string>
 
 #include "config/yaml_reader.hpp"
 #include "detect/factory.hpp"
@@ -167,6 +168,95 @@ TEST(PressureOnlyPrograms, ALeakAfterAnExcursionIsFoundAndTheStateRoundTrips) {
   }
   EXPECT_GT(raised, rig.onset);
   EXPECT_LT(raised, rig.onset + 60.0);
+}
+
+// Learned on steps, then a hold that rings the mode at 0.7 of the steps' level (above the
+// no_excitation share): it rests as much as the steps do, so the rest share alone kept judging
+// it and the unexcited index read as a leak. The rest run says it within twice the steps'
+// longest level.
+struct HoldRun {
+  double max_score = 0.0;
+  std::size_t outside = 0, hops = 0;
+  Decision last;
+};
+HoldRun hold_after_steps(Detector& detector, test::SyntheticRig& rig) {
+  HoldRun r;
+  while (rig.t < 200.0) detector.update(rig.next());
+  hold_at(rig, rig.x, 120.0);
+  while (rig.t < 320.0) {
+    r.last = detector.update(rung(rig, 0.7));
+    if (rig.t > 215.0) {
+      ++r.hops;
+      if (r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) ++r.outside;
+    }
+    if (!std::isnan(r.last.score)) r.max_score = std::max(r.max_score, r.last.score);
+  }
+  while (rig.t < 450.0) {
+    r.last = detector.update(rig.next());
+    if (!std::isnan(r.last.score)) r.max_score = std::max(r.max_score, r.last.score);
+  }
+  return r;
+}
+
+TEST(PressureOnlyPrograms, AHoldAfterTheStepsIsNotJudged) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  const HoldRun r = hold_after_steps(*detector, rig);
+  EXPECT_LT(r.max_score, 1.0);
+  EXPECT_EQ(r.outside, r.hops);  // from 15 s into the hold to its end
+  EXPECT_TRUE(r.last.judged);    // the steps again
+}
+
+// A state of the layout before the run test (index_cusum 5: the same keys without the runs)
+// loads, and judges as that build did: by the rest share alone, so the hold raises.
+TEST(PressureOnlyPrograms, AStateFromBeforeTheRunTestJudgesTheHoldAsThen) {
+  auto original = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  while (rig.t < 150.0) original->update(rig.next());
+  const DetectorState now = original->export_state();
+  DetectorState before("index_cusum", 5);
+  for (const auto& [key, values] : now.entries()) {
+    const bool run_key =
+        key.starts_with("run.") || key.ends_with("_run") || key.starts_with("regime.longest_");
+    if (!run_key) before.put(key, values);
+  }
+  auto converted = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  converted->import_state(before);
+  EXPECT_EQ(converted->export_state().version(), 6);
+  EXPECT_GE(hold_after_steps(*converted, rig).max_score, 1.0);
+}
+
+// The first learning period holds 40 s and then steps: learned across the change, the hold's
+// blocks shaped the model. It is discarded as soon as the hold outlasts any level of steps
+// (the wait is said), and the period begun when the steps begin is learned.
+TEST(PressureOnlyPrograms, ALearningPeriodWithAHoldInItIsDiscarded) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  hold_at(rig, 0.02, 40.0);
+  double learned_at = -1.0;
+  bool waited = false;
+  while (rig.t < 300.0) {
+    const Decision d = detector->update(rig.t < 40.0 ? rung(rig, 0.3) : rig.next());
+    if (d.not_judged_reason == NotJudgedReason::waiting_for_excitation) waited = true;
+    if (learned_at < 0.0 && !d.learning) learned_at = rig.t;
+  }
+  EXPECT_TRUE(waited);
+  EXPECT_GT(learned_at, 40.0 + 90.0 - 1.0);  // not on the first period
+  EXPECT_LT(learned_at, 40.0 + 90.0 + 5.0);  // a period begun with the steps
+}
+
+// The same for a period that begins with a sine block: a window of it hardly rests.
+TEST(PressureOnlyPrograms, ALearningPeriodWithASineInItIsDiscarded) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  double learned_at = -1.0;
+  while (rig.t < 300.0) {
+    if (rig.t >= 40.0 && rig.t < 40.0 + rig.hop) steps_again(rig);
+    const Decision d = detector->update(rig.t < 40.0 ? sine(rig) : rig.next());
+    if (learned_at < 0.0 && !d.learning) learned_at = rig.t;
+  }
+  EXPECT_GT(learned_at, 40.0 + 90.0 - 1.0);  // not on the first period
+  EXPECT_LT(learned_at, 40.0 + 90.0 + 5.0);  // a period begun with the steps
 }
 
 }  // namespace
