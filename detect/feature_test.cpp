@@ -91,6 +91,7 @@ void FeatureTest::reset() {
   chamber_supply_.reset();
   learned_supply_ = kMissing;
   cusum_.reset();
+  set_threshold_for_sigma();
   drift_.clear();
 }
 
@@ -263,6 +264,7 @@ void FeatureTest::finish_learning() {
   const auto n = learned_.size();
   const double sigma = std::sqrt(sum_sq / static_cast<double>(n - kRegressors));
   block_sigma_ = cusum_block_sigma(sigma, n, lag_one_correlation(sum_lag, sum_sq));
+  set_threshold_for_sigma();
 
   // The regime learned: the range of the share of hops at rest over kRegimeBlocks blocks.
   if (!(options_.regime_tolerance > 0.0) || n < kRegimeBlocks) return;
@@ -280,6 +282,20 @@ void FeatureTest::finish_learning() {
   }
   learned_rest_low_ = low;
   learned_rest_high_ = high;
+}
+
+// The increments are Gaussian log-likelihood ratios once the spread is known, so the threshold
+// follows Siegmund's approximation at the designed shift in spreads (learning_schedule.hpp)
+// instead of Lorden's bound, which was 2-3 nats higher than the target needs.
+void FeatureTest::set_threshold_for_sigma() {
+  const double lorden = cusum_threshold_for(options_.false_alarms_per_hour, options_.block_seconds);
+  if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) {
+    cusum_.set_threshold(lorden);
+    return;
+  }
+  cusum_.set_threshold(
+      cusum_threshold_for_shift(options_.false_alarms_per_hour, options_.block_seconds,
+                                (physics_.design_shift - physics_.null_shift) / block_sigma_));
 }
 
 // The spread of the learning period's block log load activity (10 % to 90 % quantile): a
@@ -464,6 +480,7 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
         key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])));
   }
   block_sigma_ = state.get(key("block_sigma"));
+  set_threshold_for_sigma();  // before the CUSUM's value, which its cap bounds
   learned_rest_low_ = state.get(key("regime.rest_low"));
   learned_rest_high_ = state.get(key("regime.rest_high"));
   restore_ring(state, key("regime.blocks"), regime_, kRegimeFields);

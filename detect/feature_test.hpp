@@ -3,7 +3,8 @@
 // still moves with the operating point, so the test learns, per rig, a quadratic model of it
 // in the load pressure plus the log of the load's activity, and tests the residual: blocks of
 // `block_seconds` (nearly independent), a CUSUM for a shift of FeaturePhysics::design_shift
-// against the null null_shift, its threshold from the target false-alarm rate.
+// against the null null_shift, its threshold from the target false-alarm rate and, once the
+// block spread is learned, the designed shift in spreads (Siegmund's approximation).
 //
 // A real rig drifts (MODEL.md "Drifting operating conditions") and so does the healthy feature:
 // - With a `temp` observation (when the physics uses it) the log of the viscous friction
@@ -120,6 +121,8 @@ class FeatureTest {
   Verdict update(const Observation& o, double feature);
 
   static constexpr double raise_threshold() { return 1.0; }
+  // The CUSUM's threshold [nats]: Lorden's until the block spread is learned, then Siegmund's.
+  double cusum_threshold() const { return cusum_.threshold(); }
   static constexpr double clear_threshold() { return 0.5; }
   double learning_seconds() const {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
@@ -169,6 +172,7 @@ class FeatureTest {
   double supply_for(const Observation& o, double load);
   double supply_from_chamber(const Observation& o, double load);
   void finish_learning();
+  void set_threshold_for_sigma();
   double anchored_until() const;
 
   FeatureTestOptions options_;
