@@ -82,6 +82,7 @@ void FeatureTest::reset() {
   excitation_wait_seconds_ = 0.0;
   cannot_learn_ = false;
   waits_for_excitation_ = true;
+  siegmund_threshold_ = true;
   block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
@@ -289,7 +290,8 @@ void FeatureTest::finish_learning() {
 // instead of Lorden's bound, which was 2-3 nats higher than the target needs.
 void FeatureTest::set_threshold_for_sigma() {
   const double lorden = cusum_threshold_for(options_.false_alarms_per_hour, options_.block_seconds);
-  if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) {
+  if (!physics_.threshold_from_spread || !siegmund_threshold_ || std::isnan(block_sigma_) ||
+      !(block_sigma_ > 0.0)) {
     cusum_.set_threshold(lorden);
     return;
   }
@@ -445,6 +447,10 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
   state.put(key("excitation.wait_seconds"), excitation_wait_seconds_);
   state.put(key("excitation.cannot_learn"), cannot_learn_ ? 1.0 : 0.0);
   state.put(key("excitation.waits"), waits_for_excitation_ ? 1.0 : 0.0);
+  // Only where the physics takes the threshold from the spread (index_cusum's layout lacks it).
+  if (physics_.threshold_from_spread) {
+    state.put(key("threshold.siegmund"), siegmund_threshold_ ? 1.0 : 0.0);
+  }
   state.put_count(key("block.rest_hops"), rest_hops_);
   state.put_count(key("block.hops"), block_hop_);
   state.put_count(key("block.valid"), block_valid_);
@@ -480,6 +486,8 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
         key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])));
   }
   block_sigma_ = state.get(key("block_sigma"));
+  siegmund_threshold_ =
+      !physics_.threshold_from_spread || state.get(key("threshold.siegmund")) != 0.0;
   set_threshold_for_sigma();  // before the CUSUM's value, which its cap bounds
   learned_rest_low_ = state.get(key("regime.rest_low"));
   learned_rest_high_ = state.get(key("regime.rest_high"));

@@ -90,6 +90,11 @@ struct FeaturePhysics {
   // with r = nu(40) / nu(T) of `oil`; `temperature_prior` is the coefficient assumed as far as
   // learning saw too little temperature range, `temperature_prior_sigma` its uncertainty.
   bool uses_temperature = false;
+  // Whether the CUSUM's threshold follows the learned spread (Siegmund's approximation at the
+  // designed shift in spreads) instead of Lorden's bound. detail_xcorr (issue 23); the log index
+  // keeps Lorden's: with Siegmund's it raised on the simulated rig's warm-up without `temp`
+  // (index_drift_sim_test), a drift its feature follows less well than the correlation.
+  bool threshold_from_spread = false;
   double temperature_prior = 0.0;
   double temperature_prior_sigma = 0.05;
   sim::Oil oil = sim::Oil::standard();
@@ -190,6 +195,9 @@ class FeatureTest {
   bool cannot_learn_ = false;
   // Whether learning waits for excitation; off for a state from a build before it.
   bool waits_for_excitation_ = true;
+  // Whether the threshold follows the learned spread (Siegmund's); off for a state from a build
+  // before it, which then decides as that build did (Lorden's).
+  bool siegmund_threshold_ = true;
   std::vector<double> scratch_;  // quantiles at the end of learning; reserved at construction
   // The block being filled.
   std::size_t block_hop_ = 0, block_valid_ = 0;
