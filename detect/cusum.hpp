@@ -20,7 +20,10 @@ namespace leakmon::detect {
 class BlockCusum {
  public:
   explicit BlockCusum(double threshold, std::size_t history_blocks = 0, double cap_factor = 4.0)
-      : threshold_(threshold), cap_(cap_factor * threshold), history_(history_blocks) {}
+      : threshold_(threshold),
+        cap_factor_(cap_factor),
+        cap_(cap_factor * threshold),
+        history_(history_blocks) {}
 
   // The block that ended at t; its value before is remembered (with a history).
   double add(double t, double llr_increment) {
@@ -33,6 +36,12 @@ class BlockCusum {
 
   double value() const { return sum_; }
   double threshold() const { return threshold_; }
+  // A threshold known only once the spread of a block is learned (the statistic keeps its value).
+  void set_threshold(double threshold) {
+    threshold_ = threshold;
+    cap_ = cap_factor_ * threshold;
+    set(sum_);
+  }
   // The statistic in units of its threshold: 1 means "raise".
   double normalised() const { return sum_ / threshold_; }
   void reset() {
@@ -55,6 +64,7 @@ class BlockCusum {
   void set(double sum) { sum_ = std::clamp(sum, 0.0, cap_); }
 
   double threshold_;
+  double cap_factor_;
   double cap_;
   double sum_ = 0.0;
   Ring<Entry> history_;

@@ -59,6 +59,7 @@ FeaturePhysics xcorr_physics(const DetailXcorrOptions& o, bool correlation) {
   const double design = correlation ? o.design_shift_correlation : o.design_shift_ratio;
   const double floor = correlation ? o.min_shift_correlation : o.min_shift_ratio;
   FeaturePhysics physics;
+  physics.threshold_from_spread = true;
   physics.design_shift = std::log1p(std::expm1(-design));
   physics.null_shift = std::log1p(std::expm1(-floor));
   physics.supply_exponent = 0.0;

@@ -85,6 +85,7 @@ void FeatureTest::reset() {
   excitation_wait_seconds_ = 0.0;
   cannot_learn_ = false;
   waits_for_excitation_ = true;
+  siegmund_threshold_ = true;
   block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
@@ -94,6 +95,7 @@ void FeatureTest::reset() {
   chamber_supply_.reset();
   learned_supply_ = kMissing;
   cusum_.reset();
+  set_threshold_for_sigma();
   drift_.clear();
 }
 
@@ -273,6 +275,7 @@ void FeatureTest::finish_learning() {
   const auto n = learned_.size();
   const double sigma = std::sqrt(sum_sq / static_cast<double>(n - kRegressors));
   block_sigma_ = cusum_block_sigma(sigma, n, lag_one_correlation(sum_lag, sum_sq));
+  set_threshold_for_sigma();
 
   // The regime learned: the range of the share of hops at rest over kRegimeBlocks blocks.
   if (!(options_.regime_tolerance > 0.0) || n < kRegimeBlocks) return;
@@ -312,6 +315,21 @@ bool FeatureTest::runs_outside() const {
   const double motion = static_cast<double>(completed_motion_run_) * hop_seconds();
   return rest > kRunFactor * learned_longest_rest_ ||
          motion > kRunFactor * learned_longest_motion_ + kMotionRunSlackSeconds;
+}
+
+// The increments are Gaussian log-likelihood ratios once the spread is known, so the threshold
+// follows Siegmund's approximation at the designed shift in spreads (learning_schedule.hpp)
+// instead of Lorden's bound, which was 2-3 nats higher than the target needs.
+void FeatureTest::set_threshold_for_sigma() {
+  const double lorden = cusum_threshold_for(options_.false_alarms_per_hour, options_.block_seconds);
+  if (!physics_.threshold_from_spread || !siegmund_threshold_ || std::isnan(block_sigma_) ||
+      !(block_sigma_ > 0.0)) {
+    cusum_.set_threshold(lorden);
+    return;
+  }
+  cusum_.set_threshold(
+      cusum_threshold_for_shift(options_.false_alarms_per_hour, options_.block_seconds,
+                                (physics_.design_shift - physics_.null_shift) / block_sigma_));
 }
 
 // The spread of the learning period's block log load activity (10 % to 90 % quantile): a
@@ -512,6 +530,10 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
   state.put(key("excitation.wait_seconds"), excitation_wait_seconds_);
   state.put(key("excitation.cannot_learn"), cannot_learn_ ? 1.0 : 0.0);
   state.put(key("excitation.waits"), waits_for_excitation_ ? 1.0 : 0.0);
+  // Only where the physics takes the threshold from the spread (index_cusum's layout lacks it).
+  if (physics_.threshold_from_spread) {
+    state.put(key("threshold.siegmund"), siegmund_threshold_ ? 1.0 : 0.0);
+  }
   state.put_count(key("block.rest_hops"), rest_hops_);
   state.put_count(key("block.hops"), block_hop_);
   state.put_count(key("block.valid"), block_valid_);
@@ -547,6 +569,9 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
         key("coefficient." + std::string(kCoefficientNames[static_cast<std::size_t>(i)])));
   }
   block_sigma_ = state.get(key("block_sigma"));
+  siegmund_threshold_ =
+      !physics_.threshold_from_spread || state.get(key("threshold.siegmund")) != 0.0;
+  set_threshold_for_sigma();  // before the CUSUM's value, which its cap bounds
   learned_rest_low_ = state.get(key("regime.rest_low"));
   learned_rest_high_ = state.get(key("regime.rest_high"));
   restore_ring(state, key("regime.blocks"), regime_, kRegimeFields);

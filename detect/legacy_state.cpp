@@ -323,10 +323,24 @@ DetectorState feature_test_from_rest_share(const DetectorState& old, int version
   return c.out();
 }
 
+// The feature test before its threshold followed the learned spread (detail_xcorr 4, and
+// before it 1-3 once converted to 4): it keeps
+// Lorden's threshold, and so decides as that build did.
+DetectorState feature_test_from_lorden(const DetectorState& old, int version,
+                                       std::string_view prefix) {
+  Conversion c(old, version);
+  for (const auto& [key, values] : old.entries()) c.put(key, values);
+  c.put(state_key(prefix, "threshold.siegmund"), 0.0);
+  return c.out();
+}
+
 }  // namespace
 
 DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
   if (state.kind() == kind && state.version() == version) return state;
+  if (state.kind() == kind && kind == "detail_xcorr" && version == 5 && state.version() < 5) {
+    return feature_test_from_lorden(upgraded_state(state, kind, 4), 5, "test");
+  }
   if (state.kind() == kind) {
     if (kind == "flow_balance" && state.version() == 2 && version == 3) return flow_from_2(state);
     if (kind == "flow_balance" && state.version() == 2 && version == 4) {

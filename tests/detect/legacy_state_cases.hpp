@@ -110,16 +110,19 @@ inline std::vector<LegacyCase> legacy_cases() {
          r.leak = 2e-12;
          r.index_drop = 0.3;
        }},
-      {"detail_xcorr", "detail_xcorr", both, "{settle_seconds: 1, learn_seconds: 20}", 45.0, 100.0,
-       true, nullptr,
+      // The shifts that build's defaults were (issue 23 changed them; the state does not hold
+      // them).
+      {"detail_xcorr", "detail_xcorr", both,
+       "{settle_seconds: 1, learn_seconds: 20, design_shift: 0.005, min_shift: 0.00125}", 45.0,
+       100.0, true, nullptr,
        [](SyntheticPressures& r) {
          r.supply_after = 14e6;
          r.supply_step_at = 40.0;
          r.onset = 70.0;
          r.leak_pole_radius = 0.9;
        }},
-      {"detail_xcorr_p1", "detail_xcorr", p1, "{settle_seconds: 1, learn_seconds: 20}", 75.0, 100.0,
-       true, nullptr,
+      {"detail_xcorr_p1", "detail_xcorr", p1,
+       "{settle_seconds: 1, learn_seconds: 20, min_shift: 0.03}", 75.0, 100.0, true, nullptr,
        [](SyntheticPressures& r) {
          r.onset = 70.0;
          r.leak_pole_radius = 0.85;
