@@ -34,6 +34,7 @@
 #include "detect/cusum.hpp"
 #include "detect/detector.hpp"
 #include "detect/drift_reference.hpp"
+#include "detect/flow_law_ladder.hpp"
 #include "detect/learned_change.hpp"
 #include "detect/learning_schedule.hpp"
 #include "detect/supply_tracker.hpp"
@@ -101,9 +102,9 @@ class FlowLawDetector final : public Detector {
 
   // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept).
   static constexpr int kStateVersion = 2;
-  // The ladder: rig.tau x 2^((i - kStatedTau) / 3), 1/8 to 8 times the stated value.
-  static constexpr std::size_t kTauCandidates = 19;
-  static constexpr std::size_t kStatedTau = 9;
+  // The ladder (flow_law_ladder.hpp).
+  static constexpr std::size_t kTauCandidates = detect::kTauCandidates;
+  static constexpr std::size_t kStatedTau = detect::kStatedTau;
   static constexpr std::size_t kTauNotChosen = kTauCandidates;
 
  private:

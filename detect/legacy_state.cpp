@@ -1,7 +1,7 @@
 #include "detect/legacy_state.hpp"
 
 #include "detect/feature_test.hpp"
-#include "detect/flow_law_detector.hpp"
+#include "detect/flow_law_ladder.hpp"
 
 #include <cmath>
 #include <initializer_list>
@@ -142,7 +142,7 @@ DetectorState flow_from_3(const DetectorState& old) {
 // flow_law 1 integrated the flow with the stated spool time constant only: layout 2's ladder
 // with that one chosen (every candidate holds its values, only the chosen is read again).
 DetectorState flow_law_from_1(const DetectorState& old) {
-  constexpr std::size_t kCandidates = FlowLawDetector::kTauCandidates;
+  constexpr std::size_t kCandidates = kTauCandidates;
   DetectorState out(old.kind(), 2);
   for (const auto& entry : old.entries()) {
     if (entry.first != "spool.opening" && entry.first != "sample.flow" &&
@@ -160,7 +160,7 @@ DetectorState flow_law_from_1(const DetectorState& old) {
   std::vector<double> y_tau;
   for (const double y : old.get_list("learned.y")) y_tau.insert(y_tau.end(), kCandidates, y);
   out.put("learned.y_tau", y_tau);
-  out.put("tau.index", static_cast<double>(FlowLawDetector::kStatedTau));
+  out.put("tau.index", static_cast<double>(kStatedTau));
   out.put("tau.fit_lag", 0.0);
   out.put("coefficient.lag", 0.0);
   out.put("learned.lag", std::vector<double>(old.get_list("learned.y").size(), 0.0));
