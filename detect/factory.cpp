@@ -415,6 +415,9 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
                               [](O& o) -> double& { return o.rest_speed; }),
+             number_option<O>("supply_rest_seconds", 0.0, 60.0,
+                              "without `ps`: ... once they have been for this long [s]",
+                              [](O& o) -> double& { return o.supply_rest_seconds; }),
              judged_memory_option<O>()} +
          drift_options<O>(1.0) + estimate_supply_options<O>() + oil_options<O>();
 }

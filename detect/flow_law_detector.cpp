@@ -48,6 +48,7 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
       design_slope_(slope_of(options.design_leak, options.rig)),
       floor_slope_(slope_of(options.min_leak, options.rig)),
       sizing_decay_(std::exp(-options.block_seconds / options.sizing_seconds)),
+      rest_hops_(std::max<std::size_t>(1, hops_in(options.supply_rest_seconds, hop_seconds))),
       clock_(options.learning, hop_seconds),
       // Twice the learning period's blocks: while waiting for excitation the newest are kept.
       learn_capacity_(2 * (clock_.learn_hops() / block_hops_ + 1)),
@@ -102,6 +103,7 @@ void FlowLawDetector::resume_after_gap() {
 // flow integrated between them, one block of many spreads.
 void FlowLawDetector::restart_block() {
   previous_x_ = kMissing;
+  still_hops_ = 0;
   openings_.fill(kMissing);
   previous_command_ = kMissing;
   have_previous_ = false;
@@ -158,11 +160,16 @@ Decision FlowLawDetector::update(const Observation& o) {
   if (o.t - last_t_ > 1.5 * hop_seconds_) restart_block();  // false when NaN
   const double speed = (o.x - previous_x_) / hop_seconds_;
   previous_x_ = o.x;
+  // At rest the lands balance only once the piston has settled: a rig hunting around its set
+  // point passes its turning points at no speed with the valve open (readings a few per cent
+  // off, each read as a supply step), so the hops must have been still for
+  // `supply_rest_seconds`.
+  still_hops_ = std::abs(speed) < options_.rest_speed ? still_hops_ + 1 : 0;  // NaN: moving
   double reading = kMissing;
   if (!std::isnan(o.ps)) {
     reading = o.ps;
   } else if (options_.estimate_supply && !std::isnan(o.p1) && !std::isnan(o.p2) &&
-             std::abs(speed) < options_.rest_speed) {
+             still_hops_ >= rest_hops_) {
     reading = o.p1 + o.p2 - options_.rig.pt;  // at rest the lands balance (MODEL.md)
   }
   supply_tracker_.add(o.t, reading, !std::isnan(o.ps));
@@ -462,6 +469,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("viscosity_ratio", viscosity_ratio_);
   state.put("hop_usable", hop_usable_ ? 1.0 : 0.0);
   state.put("previous_x", previous_x_);
+  state.put_count("still_hops", still_hops_);
   state.put("sample_seconds", sample_seconds_);
   state.put("spool.openings", openings_);
   state.put("spool.previous_command", previous_command_);
@@ -530,6 +538,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     viscosity_ratio_ = state.get("viscosity_ratio");
     hop_usable_ = state.get("hop_usable") != 0.0;
     previous_x_ = state.get("previous_x");
+    still_hops_ = state.get_count("still_hops");
     sample_seconds_ = state.get("sample_seconds");
     ladder(state, "spool.openings", openings_);
     previous_command_ = state.get("spool.previous_command");

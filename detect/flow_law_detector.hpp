@@ -62,7 +62,8 @@ struct FlowLawOptions {
   sim::Oil oil = sim::Oil::standard();
   double drift_guard_seconds = 30.0;
   double drift_window_seconds = 120.0;
-  double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers
+  double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers ...
+  double supply_rest_seconds = 0.2;  // ... once they have been for this long [s]
   bool estimate_supply = true;
   // Learn the spool's time constant from the learning blocks (a ladder of kTauCandidates values,
   // a third of an octave apart around rig.tau); false keeps rig.tau.
@@ -100,8 +101,9 @@ class FlowLawDetector final : public Detector {
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
 
-  // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept).
-  static constexpr int kStateVersion = 2;
+  // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept);
+  // layout 3 the hops at rest before the supply is read (layout 2 loads with none counted yet).
+  static constexpr int kStateVersion = 3;
   // The ladder (flow_law_ladder.hpp).
   static constexpr std::size_t kTauCandidates = detect::kTauCandidates;
   static constexpr std::size_t kStatedTau = detect::kStatedTau;
@@ -160,6 +162,7 @@ class FlowLawDetector final : public Detector {
   double design_slope_;  // design_leak in the load regressor's units (before a)
   double floor_slope_;
   double sizing_decay_;
+  std::size_t rest_hops_;  // supply_rest_seconds in hops
   LearningClock clock_;
   std::vector<Block> learned_;  // reserved at construction; the newest when waiting
   std::size_t learn_capacity_;
@@ -177,6 +180,7 @@ class FlowLawDetector final : public Detector {
   bool hop_usable_ = false;
   double sample_seconds_ = kMissing;
   double previous_x_ = kMissing;  // hop mean, for the rest test of the supply estimate
+  std::size_t still_hops_ = 0;    // consecutive hops at rest, for the same
   // The time-constant ladder: kTauNotChosen while every candidate is integrated.
   std::array<double, kTauCandidates> taus_{};
   std::size_t tau_index_ = kTauNotChosen;

@@ -167,6 +167,15 @@ DetectorState flow_law_from_1(const DetectorState& old) {
   return out;
 }
 
+// flow_law 2 read the supply at every hop at rest: layout 3 counts the hops at rest first. Counted
+// as long at rest, the converted state reads as the old build did until the piston next moves.
+DetectorState flow_law_from_2(const DetectorState& old) {
+  DetectorState out(old.kind(), 3);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  out.put("still_hops", 1e6);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -369,7 +378,10 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
-    if (kind == "flow_law" && state.version() == 1 && version == 2) return flow_law_from_1(state);
+    if (kind == "flow_law" && state.version() == 1 && version == 3) {
+      return flow_law_from_2(flow_law_from_1(state));
+    }
+    if (kind == "flow_law" && state.version() == 2 && version == 3) return flow_law_from_2(state);
     if (kind == "detail_xcorr" && state.version() == 1 && version == 2) return xcorr_from_1(state);
   }
   state.expect(kind, version);  // throws: another kind, or a layout not read here

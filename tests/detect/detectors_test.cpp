@@ -118,6 +118,7 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
                                   "sizing_seconds",
                                   "min_leak",
                                   "rest_speed",
+                                  "supply_rest_seconds",
                                   "judged_memory_seconds",
                                   "drift_guard_seconds",
                                   "drift_window_seconds",
