@@ -52,6 +52,7 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
       clock_(options.learning, hop_seconds),
       // Twice the learning period's blocks: while waiting for excitation the newest are kept.
       learn_capacity_(2 * (clock_.learn_hops() / block_hops_ + 1)),
+      run_(static_cast<std::size_t>(std::ceil(options.sizing_seconds / options.block_seconds))),
       cusum_(cusum_threshold_for(options.false_alarms_per_hour, options.block_seconds)),
       supply_tracker_(supply_options(options, hop_seconds)),
       drift_(drift_options(options, floor_slope_)) {
@@ -82,6 +83,7 @@ void FlowLawDetector::reset() {
   previous_x_ = kMissing;
   resume_after_gap();
   weighted_ = since_change_ = SlopeSums{};
+  run_.clear();
   cusum_.reset();
   supply_tracker_.reset();
   temperature_seen_ = false;
@@ -395,14 +397,52 @@ void FlowLawDetector::judge(const Block& b) {
   const double z = std::clamp(excess / block_sigma_ - floor, -kMaxZ, kMaxZ);
   const bool was_quiet = cusum_.value() <= 0.0;
   cusum_.add(b.t, shift * (z - shift / 2.0));
-  if (!temperature_seen_ && cusum_.normalised() < 0.5) drift_.add(b.t, r, b.load);
+  // The drift reference takes the block's excess winsorised as the CUSUM does: a block many
+  // spreads off is no drift of the oil, and one hop of a position pinned at its rail before the
+  // daemon held the detector (a saturated x, 6000 spreads with the leak's sign opposite) reached
+  // the window 30 s later and moved the reference by 36 spreads: internal_leakage on a healthy
+  // rig (docs/detection.md).
+  if (!temperature_seen_ && cusum_.normalised() < 0.5) {
+    const double winsorised = std::clamp(excess, -kMaxZ * block_sigma_, kMaxZ * block_sigma_);
+    drift_.add(b.t, r - excess + winsorised, b.load);
+  }
   const double rl = excess * b.load, ll = b.load * b.load;
   weighted_.rl = sizing_decay_ * weighted_.rl + rl;
   weighted_.ll = sizing_decay_ * weighted_.ll + ll;
-  if (was_quiet) since_change_ = SlopeSums{};
+  if (was_quiet) run_.clear();
   if (cusum_.value() > 0.0) {
-    since_change_.rl += rl;
-    since_change_.ll += ll;
+    run_.push({rl, ll});
+    estimate_change_point();
+  }
+}
+
+// The CUSUM leaves zero on the noise of healthy blocks too, so its run holds blocks from before
+// a leak's onset, and the block the leak opens in is part healthy: sized from all of them the
+// leak came out low at the first raise (11 % on a told rig, a quarter for a 2e-12 leak that
+// raises within two blocks; docs/detection.md). The change is placed within one block k of the
+// run: that block takes a slope of its own (the leak for part of it), the blocks after it the
+// leak's. k maximises the likelihood ratio of that model against none, with the added slope
+// unknown: (sum rl)^2 / sum ll over the blocks after k, plus block k's own rl^2 / ll (each only
+// with the leak's sign). The size is the blocks' after k; with the run's one block, that block.
+void FlowLawDetector::estimate_change_point() {
+  const double sign = coefficients_[0] < 0.0 ? -1.0 : 1.0;
+  const auto ratio = [sign](const SlopeSums& s) {
+    return s.ll > 0.0 && sign * s.rl > 0.0 ? s.rl * s.rl / s.ll : 0.0;
+  };
+  since_change_ = run_.newest();
+  SlopeSums after;  // the blocks after the candidate change block
+  double best = -1.0;
+  for (std::size_t age = 0; age < run_.size(); ++age) {
+    const SlopeSums& block = run_.newest(age);
+    if (age > 0) {
+      const double likelihood_ratio = ratio(after) + ratio(block);
+      if (likelihood_ratio > best) {
+        best = likelihood_ratio;
+        since_change_ = after;
+      }
+    }
+    after.rl += block.rl;
+    after.ll += block.ll;
   }
 }
 
@@ -423,7 +463,7 @@ Decision FlowLawDetector::decide() const {
   d.score = cusum_.normalised();
   d.judged = last_t_ - last_judged_t_ <= options_.judged_memory_seconds;  // false when NaN
   d.not_judged_reason = d.judged ? NotJudgedReason::none : block_reason_;
-  // Sized from the blocks since the CUSUM left zero only once it is suspicious: a CUSUM that
+  // Sized from the blocks since the change point only once the CUSUM is suspicious: a CUSUM that
   // only just left zero holds a block or two, too few to size anything.
   const SlopeSums& sums =
       cusum_.normalised() >= 0.5 && since_change_.ll > 0.0 ? since_change_ : weighted_;
@@ -493,6 +533,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("sizing.weighted.ll", weighted_.ll);
   state.put("sizing.since_change.rl", since_change_.rl);
   state.put("sizing.since_change.ll", since_change_.ll);
+  save_ring(state, "sizing.run", run_, run_fields());
   cusum_.save(state, "cusum");
   supply_tracker_.save(state, "supply_tracker");
   state.put("temperature_seen", temperature_seen_ ? 1.0 : 0.0);
@@ -562,6 +603,12 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     weighted_ = SlopeSums{state.get("sizing.weighted.rl"), state.get("sizing.weighted.ll")};
     since_change_ =
         SlopeSums{state.get("sizing.since_change.rl"), state.get("sizing.since_change.ll")};
+    // Layout 2 kept no run (legacy_state.cpp): sized from the blocks after the load.
+    if (state.has("sizing.run.capacity")) {
+      restore_ring(state, "sizing.run", run_, run_fields());
+    } else {
+      run_.clear();
+    }
     cusum_.restore(state, "cusum");
     supply_tracker_.restore(state, "supply_tracker");
     temperature_seen_ = state.get("temperature_seen") != 0.0;

@@ -37,6 +37,7 @@
 #include "detect/flow_law_ladder.hpp"
 #include "detect/learned_change.hpp"
 #include "detect/learning_schedule.hpp"
+#include "detect/ring.hpp"
 #include "detect/supply_tracker.hpp"
 #include "sim/oil.hpp"
 #include "sim/parameters.hpp"
@@ -102,7 +103,8 @@ class FlowLawDetector final : public Detector {
   double spool_time_constant() const;
 
   // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept);
-  // layout 3 the hops at rest before the supply is read (layout 2 loads with none counted yet).
+  // layout 3 the hops at rest before the supply is read and the CUSUM's run for the change point
+  // (layout 2 loads as long at rest and with an empty run).
   static constexpr int kStateVersion = 3;
   // The ladder (flow_law_ladder.hpp).
   static constexpr std::size_t kTauCandidates = detect::kTauCandidates;
@@ -199,11 +201,19 @@ class FlowLawDetector final : public Detector {
   std::array<double, kTauCandidates> sum_flows_{};
   double sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
   std::size_t ratio_hops_ = 0;
-  // The added slope on the load term: exponentially weighted, and since the CUSUM left zero.
+  // The added slope on the load term: exponentially weighted, and from the change point on.
   struct SlopeSums {
     double rl = 0.0, ll = 0.0;
   };
   SlopeSums weighted_, since_change_;
+  // The judged blocks of the CUSUM's current run (since it left zero), the newest
+  // `sizing_seconds` of them: the change point is the block within it from which on the added
+  // slope explains the most (since_change_ holds the sums from there).
+  static constexpr std::array<RecordField<SlopeSums>, 2> run_fields() {
+    return {record_field<&SlopeSums::rl>("rl"), record_field<&SlopeSums::ll>("ll")};
+  }
+  void estimate_change_point();
+  Ring<SlopeSums> run_;
   BlockCusum cusum_;
   SupplyTracker supply_tracker_;
   bool temperature_seen_ = false;

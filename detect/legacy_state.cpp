@@ -167,8 +167,11 @@ DetectorState flow_law_from_1(const DetectorState& old) {
   return out;
 }
 
-// flow_law 2 read the supply at every hop at rest: layout 3 counts the hops at rest first. Counted
-// as long at rest, the converted state reads as the old build did until the piston next moves.
+// flow_law 2 read the supply at every hop at rest, sized from every block since its CUSUM left
+// zero and kept no blocks of the run. Layout 3 counts the hops at rest first: counted as long at
+// rest, the converted state reads as the old build did until the piston next moves. Without the
+// run, the sums since the change are those of the old build; the run fills from the next block
+// the CUSUM judges.
 DetectorState flow_law_from_2(const DetectorState& old) {
   DetectorState out(old.kind(), 3);
   for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
