@@ -382,7 +382,8 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
         ++measured_thirds;
       }
     }
-    ringing->measured = measured_thirds ? measured_third2 / static_cast<double>(measured_thirds) : 0.0;
+    ringing->measured =
+        measured_thirds ? measured_third2 / static_cast<double>(measured_thirds) : 0.0;
     ringing->drawn = drawn_thirds ? drawn_third2 / static_cast<double>(drawn_thirds) : 0.0;
   }
   for (int c = 0; c < 3; ++c) {
