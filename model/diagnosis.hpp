@@ -91,8 +91,9 @@ struct DiagnosisSettings {
   int ringing_bisections = 7;
   std::size_t ringing_segments = 20;
   // An effect (the first or a further one) is named only where the model it extends stands
-  // above this factor times the floor: a correct model scores the floor within its Monte-Carlo
-  // spread, and an extension gaining below that has fitted the noise's propagation.
+  // above this factor times the floor, or the extended model below the floor over it: a correct
+  // model scores the floor within its Monte-Carlo spread, and an extension gaining at the floor
+  // has fitted the noise's propagation; one that beats the floor shows the floor is too high.
   double name_floor_factor = 1.1;
   // Forward selection: after the first cause, each further effect is fitted jointly with the
   // calibration and the causes named so far, and named only if it lowers the held-out error
