@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include "model/change_point.hpp"
 #include "model/force_balance.hpp"
@@ -108,6 +109,46 @@ std::vector<NamedValue> named_values(const EffectCandidate& c, const FitResult& 
     out.push_back({"channel", 0.0, 0.0, c.variant});
   }
   return out;
+}
+
+// The bulk modulus at which the floor's draws ring as fast as the capture's pressures do
+// (FloorRinging), or nothing where they already ring within `tolerance` (mean-square ratio) of
+// the capture or where its fast pressure content is mostly transducer noise. The deterministic
+// fit does not see beta on a rig whose hydraulic mode lies far above what the steps excite
+// (seed 783005: beta fitted 43 % low, held-out error equal to the true model's), yet the
+// spool flow noise that rings that mode makes most of the pressures' floor, in proportion to
+// beta / V: the floor of the fitted model came out at 0.62 of what the true model scores. The
+// ringing is read off the data, so a model that damps or softens it wrongly is not trusted
+// for the floor. Bisection in log beta within the calibration's bounds (the ringing grows with
+// beta), on a subset of the segments with one draw each.
+std::optional<double> ringing_beta(const SegmentPredictor& predictor, ModelParameters model,
+                                   std::span<const Segment> segments, const NoiseLevels& noise,
+                                   const FloorRinging& ringing, const Calibration& stated,
+                                   const DiagnosisSettings& settings) {
+  const double transducers = 20.0 * (noise.p1 * noise.p1 + noise.p2 * noise.p2);
+  if (!(ringing.measured > settings.ringing_transducer_ratio * transducers) ||
+      !(ringing.drawn > 0.0))
+    return std::nullopt;
+  const double ratio = ringing.drawn / ringing.measured;
+  if (ratio < settings.ringing_tolerance && ratio > 1.0 / settings.ringing_tolerance)
+    return std::nullopt;
+  const auto subset = spread(segments, settings.ringing_segments);
+  const auto [lower, upper] = calibration_bounds(stated);
+  const auto excess = [&](double beta) {  // log(drawn / measured) at this beta
+    model.calibration.beta = beta;
+    FloorRinging r;
+    predictor.noise_floor(model, subset, noise, settings.floor_seed, 1, settings.floor_noise_pieces,
+                          &r);
+    return std::log(std::max(r.drawn, 1e-300) / std::max(r.measured, 1e-300));
+  };
+  double lo = std::log(lower.beta), hi = std::log(upper.beta);
+  if (excess(std::exp(lo)) >= 0.0) return std::exp(lo);
+  if (excess(std::exp(hi)) <= 0.0) return std::exp(hi);
+  for (int i = 0; i < settings.ringing_bisections; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (excess(std::exp(mid)) < 0.0 ? lo : hi) = mid;
+  }
+  return std::exp(0.5 * (lo + hi));
 }
 
 }  // namespace
@@ -250,9 +291,20 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // What a correct model would score on these held-out segments, from the capture's own
   // transducer noise and the spool flow noise.
   d.noise = predictor.noise_levels();
+  FloorRinging ringing;
   d.channel_floor =
       predictor.noise_floor(nominal.parameters, d.held_out_used, d.noise, settings.floor_seed,
-                            settings.floor_repeats, settings.floor_noise_pieces);
+                            settings.floor_repeats, settings.floor_noise_pieces, &ringing);
+  d.floor_ringing = ringing;
+  if (const auto beta = ringing_beta(predictor, nominal.parameters, d.held_out_used, d.noise,
+                                     ringing, stated_calibration, settings)) {
+    ModelParameters ringing_model = nominal.parameters;
+    ringing_model.calibration.beta = *beta;
+    d.floor_beta = *beta;
+    d.channel_floor =
+        predictor.noise_floor(ringing_model, d.held_out_used, d.noise, settings.floor_seed,
+                              settings.floor_repeats, settings.floor_noise_pieces);
+  }
   d.nrmse_floor = (d.channel_floor[0] + d.channel_floor[1] + d.channel_floor[2]) / 3.0;
   const std::vector<double> nominal_errors =
       segment_errors(predictor, nominal.parameters, d.held_out_used);
@@ -423,6 +475,23 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       named = r.score >= settings.min_score && r.significance >= settings.min_significance;
       break;
     }
+  }
+  // A capture the calibrated nominal model already predicts about as well as a correct model
+  // can has nothing left for an effect to explain: an extension that still gains there has
+  // fitted the way the noise propagates, not a fault (seed 783005: entrained air named at 1.01
+  // x the true model's held-out error). A ripple stands on its own line test.
+  // Unless the extension predicts the held-out data better than the floor says any correct
+  // model can: then the floor, not the effect, is wrong (a dead band's hunting is fast
+  // pressure content the ringing match takes for noise: seed 782004, floor 0.29 against the
+  // true model's 0.18).
+  const auto at_floor = [&](double model_nrmse, double extended_nrmse) {
+    return model_nrmse <= settings.name_floor_factor * d.nrmse_floor &&
+           extended_nrmse * settings.name_floor_factor >= d.nrmse_floor;
+  };
+  if (named && winner->effect != "supply_ripple" &&
+      at_floor(d.nrmse_before, predictor.nrmse(winner->fit.parameters, d.held_out_used))) {
+    named = false;
+    d.floor_withheld = winner->effect;
   }
   // Nothing named and the calibrated nominal model above its floor would be `unexplained`:
   // before saying so, the calibration is tried from further starts across its bands (and with
@@ -601,9 +670,13 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
             std::max(paired_t(refit_errors, errors), trimmed_t(refit_errors, errors));
       }
     }
+    // The same for a further effect: the model named so far at a correct model's error leaves
+    // nothing to explain (seed 782013: a transducer offset named beside the true external leak
+    // at 0.0119 against the true model's 0.0123).
     best_step->accepted = best_step->score >= settings.min_step_score &&
                           best_step->significance >= settings.min_step_significance &&
-                          best_step->nrmse < current_nrmse;
+                          best_step->nrmse < current_nrmse &&
+                          !at_floor(current_nrmse, best_step->nrmse);
     d.steps.push_back(*best_step);
     if (!best_step->accepted) break;
     const auto shares = best_joint.split(best_fit.values);

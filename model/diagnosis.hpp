@@ -81,6 +81,20 @@ struct DiagnosisSettings {
   // At 62.5 us (32) the draw has converged (16: 0.95, 32: 0.97 of the true model's score on
   // that rig) and the floor costs a few per cent of a check (docs/model-check.md).
   int floor_noise_pieces = 32;
+  // The floor's draws are matched to the capture's fast pressure content (FloorRinging) by their
+  // bulk modulus when they ring more than `ringing_tolerance` times more or less (mean square)
+  // and the capture's content is at least `ringing_transducer_ratio` times what the transducers'
+  // noise alone gives; searched by `ringing_bisections` halvings in log beta on
+  // `ringing_segments` held-out segments (docs/model-check.md, fourth session).
+  double ringing_tolerance = 2.0;
+  double ringing_transducer_ratio = 1.0;
+  int ringing_bisections = 7;
+  std::size_t ringing_segments = 20;
+  // An effect (the first or a further one) is named only where the model it extends stands
+  // above this factor times the floor, or the extended model below the floor over it: a correct
+  // model scores the floor within its Monte-Carlo spread, and an extension gaining at the floor
+  // has fitted the noise's propagation; one that beats the floor shows the floor is too high.
+  double name_floor_factor = 1.1;
   // Forward selection: after the first cause, each further effect is fitted jointly with the
   // calibration and the causes named so far, and named only if it lowers the held-out error
   // of that model (refitted at its own optimum first: the nested comparison of diagnosis.cpp)
@@ -174,6 +188,9 @@ struct Diagnosis {
   NoiseLevels noise;                 // transducer noise read off the capture
   double nrmse_floor = 0.0;          // held-out NRMSE the noise alone leaves (FORMATS.md)
   std::array<double, 3> channel_floor{};
+  FloorRinging floor_ringing;  // of the calibrated nominal model's draws, against the capture
+  double floor_beta = 0.0;     // > 0: the floor drawn at this bulk modulus (ringing matched)
+  std::string floor_withheld;  // an effect that gained only at the floor, so was not named
   std::optional<Misfit> unexplained;          // where the reported model's leftover misfit lives
   std::vector<std::string> at_bound;          // calibrated values of the reported model on a bound
   std::vector<std::string> nominal_at_bound;  // the same for the calibrated nominal model

@@ -277,7 +277,8 @@ NoiseLevels SegmentPredictor::noise_levels() const {
 std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& parameters,
                                                     std::span<const Segment> segments,
                                                     const NoiseLevels& noise, std::uint64_t seed,
-                                                    int repeats, int pieces) const {
+                                                    int repeats, int pieces,
+                                                    FloorRinging* ringing) const {
   const ActuatorModel model(parameters, rig_);
   const std::vector<double> xs = spool_positions(model);
   std::mt19937_64 random(seed);
@@ -299,6 +300,8 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
   const std::vector<double>* measured[3] = {&record_.x, &record_.p1, &record_.p2};
   double err2[3] = {0.0, 0.0, 0.0};
   std::size_t n = 0;
+  double drawn_third2 = 0.0;
+  std::size_t drawn_thirds = 0;
   for (int r = 0; r < repeats; ++r) {
     for (const auto& seg : segments) {
       const std::size_t k0 = seg.begin;
@@ -322,6 +325,7 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
       const double piece_innovation =
           noise.spool_sigma * std::sqrt(std::max(1.0 - piece_rho * piece_rho, 0.0));
       double w_end = noise.spool_sigma * normal(random);
+      double recent[4] = {0.0, 0.0, 0.0, 0.0};  // the drawn readings' p1 - p2, newest last
       for (std::size_t j = 1; j < seg.length; ++j) {
         const std::size_t k = k0 + j;
         if (pieces <= 1) {
@@ -340,9 +344,22 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
         const Reading g = model.read(guess);
         const double truth_read[3] = {t.x, t.p1, t.p2};
         const double guess_read[3] = {g.x, g.p1, g.p2};
+        double read[3] = {0.0, 0.0, 0.0};
         for (int c = 0; c < 3; ++c) {
-          const double d = guess_read[c] - truth_read[c] - sigmas[c] * normal(random);
+          read[c] = truth_read[c] + sigmas[c] * normal(random);
+          const double d = guess_read[c] - read[c];
           if (std::isfinite(d)) err2[c] += d * d;
+        }
+        recent[0] = recent[1];
+        recent[1] = recent[2];
+        recent[2] = recent[3];
+        recent[3] = read[1] - read[2];
+        if (j >= 4) {
+          const double third = recent[3] - 3.0 * recent[2] + 3.0 * recent[1] - recent[0];
+          if (std::isfinite(third)) {
+            drawn_third2 += third * third;
+            ++drawn_thirds;
+          }
         }
         ++n;
       }
@@ -350,6 +367,25 @@ std::array<double, 3> SegmentPredictor::noise_floor(const ModelParameters& param
   }
   std::array<double, 3> out{};
   if (n == 0) return out;
+  if (ringing) {
+    double measured_third2 = 0.0;
+    std::size_t measured_thirds = 0;
+    for (const auto& seg : segments) {
+      for (std::size_t k = seg.begin + 4; k < seg.begin + seg.length; ++k) {
+        if (!(record_.valid[k - 3] && record_.valid[k - 2] && record_.valid[k - 1] &&
+              record_.valid[k]))
+          continue;
+        const auto difference = [&](std::size_t i) { return record_.p1[i] - record_.p2[i]; };
+        const double third =
+            difference(k) - 3.0 * difference(k - 1) + 3.0 * difference(k - 2) - difference(k - 3);
+        measured_third2 += third * third;
+        ++measured_thirds;
+      }
+    }
+    ringing->measured =
+        measured_thirds ? measured_third2 / static_cast<double>(measured_thirds) : 0.0;
+    ringing->drawn = drawn_thirds ? drawn_third2 / static_cast<double>(drawn_thirds) : 0.0;
+  }
   for (int c = 0; c < 3; ++c) {
     double sum = 0.0, sum2 = 0.0;
     std::size_t m = 0;

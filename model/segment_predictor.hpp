@@ -57,6 +57,13 @@ struct NoiseLevels {
   double spool_sigma = 0.0, spool_tau = 1e-3;
 };
 
+// The fast part of the pressure difference p1 - p2 (mean square of its third differences on
+// the floor's segments), in the capture and in the floor's draws: the spool flow noise rings
+// the hydraulic mode there, far above what the steps excite.
+struct FloorRinging {
+  double measured = 0.0, drawn = 0.0;
+};
+
 class SegmentPredictor {
  public:
   explicit SegmentPredictor(const MeasuredRecord& record,
@@ -95,7 +102,8 @@ class SegmentPredictor {
   // exact Ornstein-Uhlenbeck draw at their spacing); 1 holds each sample's mean.
   std::array<double, 3> noise_floor(const ModelParameters& parameters,
                                     std::span<const Segment> segments, const NoiseLevels& noise,
-                                    std::uint64_t seed, int repeats = 3, int pieces = 1) const;
+                                    std::uint64_t seed, int repeats = 3, int pieces = 1,
+                                    FloorRinging* ringing = nullptr) const;
 
  private:
   // `before`: the model up to onset_s, when an effect starts inside the capture.
