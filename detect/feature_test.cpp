@@ -507,6 +507,60 @@ void FeatureTest::learn_other(const Block& block) {
   if (candidate_.size() >= clock_.learn_hops() / block_hops_) finish_other();
 }
 
+// Judged by that program's baseline, in its spreads; its residuals stay out of the drift
+// reference, which follows the first program's.
+void FeatureTest::judge_other(const Block& block, std::size_t other, double reference) {
+  const OtherRegime& r = others_[other];
+  last_expected_ = other_expected(r, block) + reference - r.reference;
+  const double null_shift = physics_.null_shift / r.sigma;
+  const double shift = physics_.design_shift / r.sigma;
+  const double z = (block.feature - last_expected_) / r.sigma;
+  cusum_.add(block.t, (shift - null_shift) * (z - (shift + null_shift) / 2.0));
+}
+
+// Before the steps are learned (or when they cannot be: a rig that runs sines for hours), a
+// program that hardly rests (its rest share over kRegimeBlocks blocks below what a learning
+// period of steps shows) is learned and judged as another regime all the same; the steps'
+// learning goes on beside it. There is no drift reference yet, and the load and activity terms
+// are pulled towards none.
+bool FeatureTest::judge_without_steps(bool completed, const Block& block, Verdict& verdict) {
+  if (!learns_other_regimes_ || !waits_for_excitation_ || !(options_.regime_tolerance > 0.0) ||
+      !(options_.min_excitation_range > 0.0)) {
+    return false;
+  }
+  if (completed && !chamber_supply_.awaiting()) {
+    regime_.push({block.t, block.rest_share, kMissing, block.log_activity});
+    bool moving = false;
+    if (regime_.full()) {
+      double share = 0.0;
+      for (std::size_t i = 0; i < regime_.size(); ++i) share += regime_.oldest(i).share;
+      moving = share < kLearningRestShare * static_cast<double>(regime_.size());
+    }
+    const int other = moving ? other_regime_of_ring() : -1;
+    if (other != judging_other_) {
+      if (judging_other_ >= 0) take_back_ring();
+      judging_other_ = other;
+      candidate_.clear();
+      candidate_rest_run_ = candidate_motion_run_ = 0;
+    }
+    if (other >= 0) {
+      judge_other(block, static_cast<std::size_t>(other), 0.0);
+    } else if (moving) {
+      learn_other(block);
+    } else {
+      candidate_.clear();
+      candidate_rest_run_ = candidate_motion_run_ = 0;
+    }
+  }
+  if (judging_other_ < 0) return false;
+  verdict.learning = false;
+  verdict.learning_hops_left = kMissing;
+  verdict.not_judged = NotJudgedReason::none;
+  verdict.expected = last_expected_;
+  verdict.score = cusum_.normalised();
+  return true;
+}
+
 double FeatureTest::other_expected(const OtherRegime& r, const Block& b) const {
   return r.constant + r.load * b.load + r.load_squared * b.load_squared +
          r.log_activity * b.log_activity + coefficients_[4] * b.log_friction +
@@ -555,7 +609,9 @@ void FeatureTest::finish_other() {
     return;
   }
   r.reference =
-      drift_.reference(candidate_.back().t, block_sigma_, temperature_seen_, anchored_until());
+      clock_.learned() && !cannot_learn_ && block_sigma_ > 0.0
+          ? drift_.reference(candidate_.back().t, block_sigma_, temperature_seen_, anchored_until())
+          : 0.0;
   r.rest_low = r.activity_low = 1e300;
   r.rest_high = r.activity_high = -1e300;
   double share = 0.0, activity = 0.0;
@@ -637,11 +693,16 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
     if (excitation_wait_seconds_ > 0.0 && !clock_.learned()) {
       verdict.not_judged = NotJudgedReason::waiting_for_excitation;
     }
-    if (!cannot_learn_) return verdict;
+    if (!cannot_learn_) {
+      judge_without_steps(completed, block, verdict);
+      return verdict;
+    }
   }
   verdict.learning = false;
   if (cannot_learn_) {
-    verdict.not_judged = NotJudgedReason::cannot_learn;
+    if (!judge_without_steps(completed, block, verdict)) {
+      verdict.not_judged = NotJudgedReason::cannot_learn;
+    }
     return verdict;
   }
   if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) return verdict;
@@ -667,14 +728,7 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
         learn_other(block);
         verdict.not_judged = NotJudgedReason::outside_learned_regime;
       } else {
-        // Judged by that program's baseline, in its spreads; its residuals stay out of the drift
-        // reference, which follows the first program's.
-        const OtherRegime& r = others_[static_cast<std::size_t>(other)];
-        last_expected_ = other_expected(r, block) + reference - r.reference;
-        const double null_shift = physics_.null_shift / r.sigma;
-        const double shift = physics_.design_shift / r.sigma;
-        const double z = (block.feature - last_expected_) / r.sigma;
-        cusum_.add(block.t, (shift - null_shift) * (z - (shift + null_shift) / 2.0));
+        judge_other(block, static_cast<std::size_t>(other), reference);
       }
     } else {
       if (judging_other_ >= 0) {

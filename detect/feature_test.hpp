@@ -56,6 +56,8 @@
 //   the same in every program; what the excitation changes is the baseline. A period that
 //   changes program (its rest share or activity moves by more than a program's own scatter)
 //   starts over. A program neither learned nor learnable stays `outside_learned_regime`.
+//   Such a program is learned and judged before the steps are learned too (a shift that
+//   begins with a durability block), while the steps' learning waits beside it.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -252,6 +254,10 @@ class FeatureTest {
   // Leaving the regime whose baseline judged the ring's blocks: they belong to the next program.
   void take_back_ring();
   double other_expected(const OtherRegime& r, const Block& block) const;
+  void judge_other(const Block& block, std::size_t other, double reference);
+  // Before the steps are learned: a program without rests learned and judged as another regime
+  // (the file comment); true when the hop is judged so.
+  bool judge_without_steps(bool completed, const Block& block, Verdict& verdict);
   double supply_for(const Observation& o, double load);
   double supply_from_chamber(const Observation& o, double load);
   void finish_learning();

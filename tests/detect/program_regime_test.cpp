@@ -273,8 +273,8 @@ TEST(PressureOnlyPrograms, ALearningPeriodWithASineInItIsDiscarded) {
 struct SineRun {
   double max_healthy_score = 0.0;
   double first_raise = -1.0;
-  // In the sine, from when it was first said outside the learned regime (the first blocks of a
-  // new program are judged until the regime ring shows it, and taken back then).
+  // In the sine, from when it was first said outside the learned regime or learning (the first
+  // blocks of a new program are judged until the regime ring shows it, and taken back then).
   double first_judged = -1.0;
   std::size_t judged = 0, hops = 0;  // in the sine after its first 15 s
   bool said_outside = false;
@@ -288,7 +288,7 @@ SineRun steps_then_sine(Detector& detector, test::SyntheticRig& rig, double sine
     const bool in_sine = rig.t >= sine_from;
     r.last = detector.update(in_sine ? sine(rig) : rig.next());
     if (in_sine) {
-      if (r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) {
+      if (r.last.learning || r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) {
         r.said_outside = true;
       }
       if (rig.t > sine_from + 15.0) {
@@ -429,6 +429,48 @@ TEST(PressureOnlyPrograms, AStateFromBeforeLearnsNoOtherProgram) {
   const SineRun r = steps_then_sine(*converted, rig, 200.0, 500.0);
   EXPECT_EQ(r.judged, 0U);
   EXPECT_EQ(r.last.not_judged_reason, NotJudgedReason::outside_learned_regime);
+}
+
+// A shift that begins with a durability block: before any steps the sine is learned and judged
+// by its own baseline (a leak in it found within 60 s), while the steps' learning waits; the
+// steps that follow are learned as before, and the sine is told again after them.
+TEST(PressureOnlyPrograms, ASineBeforeAnyStepsIsLearnedAndJudged) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  const SineRun sine_first = steps_then_sine(*detector, rig, 0.0, 200.0);
+  EXPECT_LT(sine_first.max_healthy_score, 1.0);
+  EXPECT_GT(sine_first.first_judged, 90.0);
+  EXPECT_LT(sine_first.first_judged, 90.0 + 20.0);
+  EXPECT_TRUE(sine_first.last.judged);
+  steps_again(rig);
+  double learned_at = -1.0;
+  Decision d;
+  while (rig.t < 400.0) {
+    d = detector->update(rig.next());
+    if (learned_at < 0.0 && !d.learning && d.judged && rig.t > 215.0) learned_at = rig.t;
+    if (!std::isnan(d.score)) {
+      EXPECT_LT(d.score, 1.0) << rig.t;
+    }
+  }
+  EXPECT_LT(learned_at, 200.0 + 90.0 + 10.0);
+  rig.onset = 440.0;
+  rig.index_drop = 0.3;
+  const SineRun again = steps_then_sine(*detector, rig, 400.0, 520.0);
+  EXPECT_LT(again.max_healthy_score, 1.0);
+  EXPECT_LT(again.first_judged, 400.0 + 15.0);
+  EXPECT_GT(again.first_raise, rig.onset);
+  EXPECT_LT(again.first_raise, rig.onset + 60.0);
+}
+
+TEST(PressureOnlyPrograms, ALeakInASineBeforeAnyStepsIsFound) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 150.0;
+  rig.index_drop = 0.3;
+  const SineRun r = steps_then_sine(*detector, rig, 0.0, 260.0);
+  EXPECT_LT(r.max_healthy_score, 1.0);
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 60.0);
 }
 
 }  // namespace
