@@ -67,6 +67,7 @@ FeatureTest::FeatureTest(const FeatureTestOptions& options, const FeaturePhysics
       regime_(kRegimeBlocks) {
   learned_.reserve(clock_.learn_hops() / block_hops_ + 1);
   scratch_.reserve(learned_.capacity());
+  candidate_.reserve(learned_.capacity());
   coefficients_[4] = physics.temperature_prior;
 }
 
@@ -86,6 +87,12 @@ void FeatureTest::reset() {
   cannot_learn_ = false;
   waits_for_excitation_ = true;
   siegmund_threshold_ = true;
+  others_ = {};
+  other_count_ = 0;
+  judging_other_ = -1;
+  learns_other_regimes_ = true;
+  candidate_.clear();
+  candidate_rest_run_ = candidate_motion_run_ = 0;
   block_hop_ = block_valid_ = rest_hops_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
@@ -108,6 +115,9 @@ void FeatureTest::resume_after_gap() {
   // The regime's blocks are on the old clock too (their residuals never reach the reference).
   regime_.clear();
   outside_ = false;
+  judging_other_ = -1;
+  candidate_.clear();
+  candidate_rest_run_ = candidate_motion_run_ = 0;
   rest_run_ = motion_run_ = block_rest_run_ = block_motion_run_ = 0;
 }
 
@@ -389,7 +399,7 @@ bool FeatureTest::outside_regime(const Block& block) {
   if (regime_.full() && !std::isnan(regime_.oldest().residual)) {
     drift_.add(regime_.oldest().t, regime_.oldest().residual);
   }
-  regime_.push({block.t, block.rest_share, kMissing});
+  regime_.push({block.t, block.rest_share, kMissing, block.log_activity});
   bool outside = outside_;  // after a gap: too few blocks to say from the share
   if (regime_.full()) {
     double sum = 0.0;
@@ -409,6 +419,221 @@ bool FeatureTest::outside_regime(const Block& block) {
   }
   outside_ = outside;
   return outside;
+}
+
+void FeatureTest::take_back_ring() {
+  if (regime_.empty()) return;
+  cusum_.take_back_after(regime_.oldest().t - 0.5 * options_.block_seconds);
+  for (std::size_t age = 0; age < regime_.size(); ++age) regime_.newest(age).residual = kMissing;
+}
+
+// The ring's means against each learned other program; the one judging stays on with the
+// full tolerances, another is entered only well inside them (no flicker between two programs
+// near each other's edges).
+int FeatureTest::other_regime_of_ring() const {
+  if (other_count_ == 0 || !regime_.full()) return -1;
+  double share = 0.0, activity = 0.0;
+  for (std::size_t i = 0; i < regime_.size(); ++i) {
+    share += regime_.oldest(i).share;
+    activity += regime_.oldest(i).activity;
+  }
+  share /= static_cast<double>(regime_.size());
+  activity /= static_cast<double>(regime_.size());
+  if (std::isnan(share) || std::isnan(activity)) return -1;  // a ring from a state before it
+  const double rest = static_cast<double>(completed_rest_run_) * hop_seconds();
+  const double motion = static_cast<double>(completed_motion_run_) * hop_seconds();
+  const auto fits = [&](std::size_t k) {
+    const OtherRegime& r = others_[k];
+    const double widen = static_cast<int>(k) == judging_other_ ? 1.0 : 0.5;
+    const double share_margin = widen * options_.regime_tolerance;
+    const double activity_margin = widen * kActivityTolerance;
+    return share >= r.rest_low - share_margin && share <= r.rest_high + share_margin &&
+           activity >= r.activity_low - activity_margin &&
+           activity <= r.activity_high + activity_margin &&
+           rest <= kRunFactor * r.longest_rest + kMotionRunSlackSeconds &&
+           motion <= kRunFactor * r.longest_motion + kMotionRunSlackSeconds;
+  };
+  if (judging_other_ >= 0 && fits(static_cast<std::size_t>(judging_other_))) return judging_other_;
+  for (std::size_t k = 0; k < other_count_; ++k) {
+    if (fits(k)) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+// A program that is neither the first nor a learned other one: its blocks are gathered for a
+// learning period. A hold (a rest run longer than any level of steps) is not learned: it hardly
+// rings the mode, and a leak's flow there depends on where it holds. A period whose rest share
+// or activity moves by more than one program scatters began in another program: it keeps only
+// its latest blocks.
+void FeatureTest::learn_other(const Block& block) {
+  if (!learns_other_regimes_ || other_count_ >= kMaxOtherRegimes ||
+      !(options_.regime_tolerance > 0.0)) {
+    return;
+  }
+  if (static_cast<double>(completed_rest_run_) * hop_seconds() > kLongestLearningRestSeconds) {
+    candidate_.clear();
+    candidate_rest_run_ = candidate_motion_run_ = 0;
+    return;
+  }
+  candidate_.push_back(block);  // capacity reserved; finished before it fills
+  candidate_rest_run_ = std::max(candidate_rest_run_, completed_rest_run_);
+  candidate_motion_run_ = std::max(candidate_motion_run_, completed_motion_run_);
+  if (candidate_.size() >= kRegimeBlocks) {
+    double share_low = 1e300, share_high = -1e300, activity_low = 1e300, activity_high = -1e300;
+    double share = 0.0, activity = 0.0;
+    for (std::size_t i = 0; i < candidate_.size(); ++i) {
+      share += candidate_[i].rest_share;
+      activity += candidate_[i].log_activity;
+      if (i >= kRegimeBlocks) {
+        share -= candidate_[i - kRegimeBlocks].rest_share;
+        activity -= candidate_[i - kRegimeBlocks].log_activity;
+      }
+      if (i + 1 < kRegimeBlocks) continue;
+      const double n = static_cast<double>(kRegimeBlocks);
+      share_low = std::min(share_low, share / n);
+      share_high = std::max(share_high, share / n);
+      activity_low = std::min(activity_low, activity / n);
+      activity_high = std::max(activity_high, activity / n);
+    }
+    if (share_high - share_low > 2.0 * options_.regime_tolerance ||
+        activity_high - activity_low > 2.0 * kActivityTolerance) {
+      const auto keep = static_cast<std::ptrdiff_t>(kRegimeBlocks / 2);
+      candidate_.erase(candidate_.begin(), candidate_.end() - keep);
+      candidate_rest_run_ = completed_rest_run_;
+      candidate_motion_run_ = completed_motion_run_;
+      return;
+    }
+  }
+  if (candidate_.size() >= clock_.learn_hops() / block_hops_) finish_other();
+}
+
+// Judged by that program's baseline, in its spreads; its residuals stay out of the drift
+// reference, which follows the first program's.
+void FeatureTest::judge_other(const Block& block, std::size_t other, double reference) {
+  const OtherRegime& r = others_[other];
+  last_expected_ = other_expected(r, block) + reference - r.reference;
+  const double null_shift = physics_.null_shift / r.sigma;
+  const double shift = physics_.design_shift / r.sigma;
+  const double z = (block.feature - last_expected_) / r.sigma;
+  cusum_.add(block.t, (shift - null_shift) * (z - (shift + null_shift) / 2.0));
+}
+
+// Before the steps are learned (or when they cannot be: a rig that runs sines for hours), a
+// program that hardly rests (its rest share over kRegimeBlocks blocks below what a learning
+// period of steps shows) is learned and judged as another regime all the same; the steps'
+// learning goes on beside it. There is no drift reference yet, and the load and activity terms
+// are pulled towards none.
+bool FeatureTest::judge_without_steps(bool completed, const Block& block, Verdict& verdict) {
+  if (!learns_other_regimes_ || !waits_for_excitation_ || !(options_.regime_tolerance > 0.0) ||
+      !(options_.min_excitation_range > 0.0)) {
+    return false;
+  }
+  if (completed && !chamber_supply_.awaiting()) {
+    regime_.push({block.t, block.rest_share, kMissing, block.log_activity});
+    bool moving = false;
+    if (regime_.full()) {
+      double share = 0.0;
+      for (std::size_t i = 0; i < regime_.size(); ++i) share += regime_.oldest(i).share;
+      moving = share < kLearningRestShare * static_cast<double>(regime_.size());
+    }
+    const int other = moving ? other_regime_of_ring() : -1;
+    if (other != judging_other_) {
+      if (judging_other_ >= 0) take_back_ring();
+      judging_other_ = other;
+      candidate_.clear();
+      candidate_rest_run_ = candidate_motion_run_ = 0;
+    }
+    if (other >= 0) {
+      judge_other(block, static_cast<std::size_t>(other), 0.0);
+    } else if (moving) {
+      learn_other(block);
+    } else {
+      candidate_.clear();
+      candidate_rest_run_ = candidate_motion_run_ = 0;
+    }
+  }
+  if (judging_other_ < 0) return false;
+  verdict.learning = false;
+  verdict.learning_hops_left = kMissing;
+  verdict.not_judged = NotJudgedReason::none;
+  verdict.expected = last_expected_;
+  verdict.score = cusum_.normalised();
+  return true;
+}
+
+double FeatureTest::other_expected(const OtherRegime& r, const Block& b) const {
+  return r.constant + r.load * b.load + r.load_squared * b.load_squared +
+         r.log_activity * b.log_activity + coefficients_[4] * b.log_friction +
+         physics_.supply_exponent * b.log_supply;
+}
+
+// The other program's baseline from its learning period: the constant is what the excitation
+// sets; the load and activity terms are the first program's as far as this period's blocks
+// spanned too little of them to say (one pseudo-observation each, weighing as much as the data
+// when the regressor's spread is kPriorSpread).
+void FeatureTest::finish_other() {
+  const std::size_t n = candidate_.size();
+  if (n < 2 * kRegressors) return;
+  const auto response = [this](const Block& b) {
+    return b.feature - physics_.supply_exponent * b.log_supply - coefficients_[4] * b.log_friction;
+  };
+  LeastSquares<4> fit;
+  for (const auto& b : candidate_) {
+    fit.add(Eigen::Vector4d(1.0, b.load, b.load_squared, b.log_activity), response(b));
+  }
+  constexpr std::array<double, 3> kPriorSpread = {0.1, 0.03, 0.3};
+  for (int j = 1; j < 4; ++j) {
+    const double w =
+        std::sqrt(static_cast<double>(n)) * kPriorSpread[static_cast<std::size_t>(j - 1)];
+    Eigen::Vector4d row = Eigen::Vector4d::Zero();
+    row[j] = w;
+    fit.add(row, w * coefficients_[j]);
+  }
+  const Eigen::Vector4d beta = fit.solve();
+  OtherRegime r{};
+  r.constant = beta[0];
+  r.load = beta[1];
+  r.load_squared = beta[2];
+  r.log_activity = beta[3];
+  double sum_sq = 0.0, sum_lag = 0.0, previous = kMissing;
+  for (const auto& b : candidate_) {
+    const double e = b.feature - other_expected(r, b);
+    sum_sq += e * e;
+    if (!std::isnan(previous)) sum_lag += e * previous;
+    previous = e;
+  }
+  const double sigma = std::sqrt(sum_sq / static_cast<double>(n - 4));
+  r.sigma = cusum_block_sigma(sigma, n, lag_one_correlation(sum_lag, sum_sq));
+  if (!(r.sigma > 0.0)) {
+    candidate_.clear();
+    return;
+  }
+  r.reference =
+      clock_.learned() && !cannot_learn_ && block_sigma_ > 0.0
+          ? drift_.reference(candidate_.back().t, block_sigma_, temperature_seen_, anchored_until())
+          : 0.0;
+  r.rest_low = r.activity_low = 1e300;
+  r.rest_high = r.activity_high = -1e300;
+  double share = 0.0, activity = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    share += candidate_[i].rest_share;
+    activity += candidate_[i].log_activity;
+    if (i >= kRegimeBlocks) {
+      share -= candidate_[i - kRegimeBlocks].rest_share;
+      activity -= candidate_[i - kRegimeBlocks].log_activity;
+    }
+    if (i + 1 < kRegimeBlocks) continue;
+    const double k = static_cast<double>(kRegimeBlocks);
+    r.rest_low = std::min(r.rest_low, share / k);
+    r.rest_high = std::max(r.rest_high, share / k);
+    r.activity_low = std::min(r.activity_low, activity / k);
+    r.activity_high = std::max(r.activity_high, activity / k);
+  }
+  r.longest_rest = static_cast<double>(candidate_rest_run_) * hop_seconds();
+  r.longest_motion = static_cast<double>(candidate_motion_run_) * hop_seconds();
+  others_[other_count_++] = r;
+  candidate_.clear();
+  candidate_rest_run_ = candidate_motion_run_ = 0;
 }
 
 // A healthy block's residual for the drift reference: through the regime ring when the block
@@ -468,11 +693,16 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
     if (excitation_wait_seconds_ > 0.0 && !clock_.learned()) {
       verdict.not_judged = NotJudgedReason::waiting_for_excitation;
     }
-    if (!cannot_learn_) return verdict;
+    if (!cannot_learn_) {
+      judge_without_steps(completed, block, verdict);
+      return verdict;
+    }
   }
   verdict.learning = false;
   if (cannot_learn_) {
-    verdict.not_judged = NotJudgedReason::cannot_learn;
+    if (!judge_without_steps(completed, block, verdict)) {
+      verdict.not_judged = NotJudgedReason::cannot_learn;
+    }
     return verdict;
   }
   if (std::isnan(block_sigma_) || !(block_sigma_ > 0.0)) return verdict;
@@ -487,8 +717,26 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
     if (anchoring) {
       drift_.add(block.t, residual);
     } else if (outside_regime(block)) {
-      verdict.not_judged = NotJudgedReason::outside_learned_regime;
+      const int other = other_regime_of_ring();
+      if (other != judging_other_) {
+        if (judging_other_ >= 0) take_back_ring();
+        judging_other_ = other;
+        candidate_.clear();
+        candidate_rest_run_ = candidate_motion_run_ = 0;
+      }
+      if (other < 0) {
+        learn_other(block);
+        verdict.not_judged = NotJudgedReason::outside_learned_regime;
+      } else {
+        judge_other(block, static_cast<std::size_t>(other), reference);
+      }
     } else {
+      if (judging_other_ >= 0) {
+        take_back_ring();
+        judging_other_ = -1;
+      }
+      candidate_.clear();
+      candidate_rest_run_ = candidate_motion_run_ = 0;
       // Log-likelihood ratio of "the mean residual is design_shift" against "null_shift", per
       // block.
       const double null_shift = physics_.null_shift / block_sigma_;
@@ -498,7 +746,7 @@ FeatureTest::Verdict FeatureTest::update(const Observation& o, double feature) {
       // Blocks under suspicion stay out of the reference: a leak is never learned as drift.
       if (cusum_.normalised() < 0.5) add_to_reference(block, residual);
     }
-  } else if (outside_) {
+  } else if (outside_ && judging_other_ < 0) {
     verdict.not_judged = NotJudgedReason::outside_learned_regime;
   }
   verdict.expected = last_expected_;
@@ -530,6 +778,13 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
   state.put(key("excitation.wait_seconds"), excitation_wait_seconds_);
   state.put(key("excitation.cannot_learn"), cannot_learn_ ? 1.0 : 0.0);
   state.put(key("excitation.waits"), waits_for_excitation_ ? 1.0 : 0.0);
+  put_records(state, key("others"), std::span<const OtherRegime>(others_.data(), other_count_),
+              kOtherRegimeFields);
+  state.put(key("others.judging"), static_cast<double>(judging_other_));
+  state.put(key("others.learns"), learns_other_regimes_ ? 1.0 : 0.0);
+  put_records(state, key("others.candidate"), std::span<const Block>(candidate_), kBlockFields);
+  state.put_count(key("others.candidate_rest_run"), candidate_rest_run_);
+  state.put_count(key("others.candidate_motion_run"), candidate_motion_run_);
   // Only where the physics takes the threshold from the spread (index_cusum's layout lacks it).
   if (physics_.threshold_from_spread) {
     state.put(key("threshold.siegmund"), siegmund_threshold_ ? 1.0 : 0.0);
@@ -587,6 +842,25 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
   excitation_wait_seconds_ = state.get(key("excitation.wait_seconds"));
   cannot_learn_ = state.get(key("excitation.cannot_learn")) != 0.0;
   waits_for_excitation_ = state.get(key("excitation.waits")) != 0.0;
+  other_count_ = record_count(state, key("others"), kOtherRegimeFields);
+  if (other_count_ > kMaxOtherRegimes) throw StateError("more other regimes than are learned");
+  get_records(state, key("others"), kOtherRegimeFields,
+              std::span<OtherRegime>(others_.data(), other_count_));
+  const double judging = state.get(key("others.judging"));
+  if (!(judging >= -1.0) || !(judging < static_cast<double>(other_count_)) ||
+      std::floor(judging) != judging) {
+    throw StateError("the judging regime is not a learned one");
+  }
+  judging_other_ = static_cast<int>(judging);
+  learns_other_regimes_ = state.get(key("others.learns")) != 0.0;
+  const std::size_t candidate = record_count(state, key("others.candidate"), kBlockFields);
+  if (candidate > candidate_.capacity()) {
+    throw StateError("more candidate blocks than this configuration learns");
+  }
+  candidate_.resize(candidate);  // within the reserved capacity
+  get_records(state, key("others.candidate"), kBlockFields, std::span<Block>(candidate_));
+  candidate_rest_run_ = state.get_count(key("others.candidate_rest_run"));
+  candidate_motion_run_ = state.get_count(key("others.candidate_motion_run"));
   rest_hops_ = state.get_count(key("block.rest_hops"));
   block_hop_ = state.get_count(key("block.hops"));
   block_valid_ = state.get_count(key("block.valid"));

@@ -47,6 +47,17 @@
 //   shows it (not at its end), so the next period begins with the program that follows. A
 //   period learned across a program change took both programs' rest shares as its regime and
 //   judged either by one model. min_excitation_range 0 switches these checks off as well.
+// - Another program that lasts a learning period and rings the mode (a sine, triangle or sweep
+//   block of minutes; not a hold, whose rest run outlasts any level of steps) is learned as a
+//   regime of its own, up to kMaxOtherRegimes: its rest share, mean log load activity and
+//   longest runs say when it runs again, and its own baseline of the feature (the constant,
+//   with the load and activity terms pulled towards the steps' as far as the block saw too
+//   little of them) judges it then, in spreads of its own. What a leak does to the feature is
+//   the same in every program; what the excitation changes is the baseline. A period that
+//   changes program (its rest share or activity moves by more than a program's own scatter)
+//   starts over. A program neither learned nor learnable stays `outside_learned_regime`.
+//   Such a program is learned and judged before the steps are learned too (a shift that
+//   begins with a durability block), while the steps' learning waits beside it.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -141,6 +152,16 @@ class FeatureTest {
   // What a learning period must show to be one program that moves and rests (the file comment).
   static constexpr double kLearningRestShare = 0.3;
   static constexpr double kLongestLearningRestSeconds = 20.0;
+  // Per-regime learning (the file comment): how many programs besides the first one are
+  // learned, and how far (in ln) a program's mean log load activity over kRegimeBlocks blocks
+  // may lie outside its learned range and still be that program (a sine at another amplitude or
+  // frequency moves the load's activity by its ratio).
+  static constexpr std::size_t kMaxOtherRegimes = 3;
+  static constexpr double kActivityTolerance = 0.4;
+  // The other regime whose baseline judges the current blocks (-1: none), and how many are
+  // learned: for the tests and the status.
+  int judging_regime() const { return judging_other_; }
+  std::size_t other_regimes() const { return other_count_; }
   // One hop: `feature` over the window that ended at o.t (NaN: a gap; nothing is judged then),
   // with the observation's pressures (and its temperature when the physics uses it).
   Verdict update(const Observation& o, double feature);
@@ -178,11 +199,34 @@ class FeatureTest {
   // waiting to enter the drift reference (NaN: it does not) until kRegimeBlocks later blocks
   // showed no excursion.
   struct RegimeEntry {
-    double t, share, residual;
+    double t, share, residual, activity;
   };
-  static constexpr std::array<RecordField<RegimeEntry>, 3> kRegimeFields = {
+  static constexpr std::array<RecordField<RegimeEntry>, 4> kRegimeFields = {
       record_field<&RegimeEntry::t>("t"), record_field<&RegimeEntry::share>("share"),
-      record_field<&RegimeEntry::residual>("residual")};
+      record_field<&RegimeEntry::residual>("residual"),
+      record_field<&RegimeEntry::activity>("activity")};
+  // A program learned besides the first: the feature's model in it (constant, load, load^2,
+  // log activity; the temperature term is the first program's), its block spread, the drift
+  // reference when it was learned (its baseline moves with the reference since), and what tells
+  // it: the range of its rest share and mean log activity over kRegimeBlocks blocks, and its
+  // longest rest and motion runs [s].
+  struct OtherRegime {
+    double constant, load, load_squared, log_activity, sigma, reference;
+    double rest_low, rest_high, activity_low, activity_high, longest_rest, longest_motion;
+  };
+  static constexpr std::array<RecordField<OtherRegime>, 12> kOtherRegimeFields = {
+      record_field<&OtherRegime::constant>("constant"),
+      record_field<&OtherRegime::load>("load"),
+      record_field<&OtherRegime::load_squared>("load_squared"),
+      record_field<&OtherRegime::log_activity>("log_activity"),
+      record_field<&OtherRegime::sigma>("sigma"),
+      record_field<&OtherRegime::reference>("reference"),
+      record_field<&OtherRegime::rest_low>("rest_low"),
+      record_field<&OtherRegime::rest_high>("rest_high"),
+      record_field<&OtherRegime::activity_low>("activity_low"),
+      record_field<&OtherRegime::activity_high>("activity_high"),
+      record_field<&OtherRegime::longest_rest>("longest_rest"),
+      record_field<&OtherRegime::longest_motion>("longest_motion")};
   static constexpr int kRegressors = 5;
   double load_of(const Observation& o, double supply) const;
   double expected_feature(const Block& block) const;
@@ -202,6 +246,18 @@ class FeatureTest {
   void add_to_reference(const Block& block, double residual);
   bool regime_known() const { return !std::isnan(learned_rest_low_); }
   bool runs_known() const { return !std::isnan(learned_longest_rest_); }
+  // Outside the first program: the learned other program the ring's blocks show (-1: none).
+  int other_regime_of_ring() const;
+  // An unrecognised program's block: learning it as another regime, or starting over.
+  void learn_other(const Block& block);
+  void finish_other();
+  // Leaving the regime whose baseline judged the ring's blocks: they belong to the next program.
+  void take_back_ring();
+  double other_expected(const OtherRegime& r, const Block& block) const;
+  void judge_other(const Block& block, std::size_t other, double reference);
+  // Before the steps are learned: a program without rests learned and judged as another regime
+  // (the file comment); true when the hop is judged so.
+  bool judge_without_steps(bool completed, const Block& block, Verdict& verdict);
   double supply_for(const Observation& o, double load);
   double supply_from_chamber(const Observation& o, double load);
   void finish_learning();
@@ -253,6 +309,14 @@ class FeatureTest {
   BlockCusum cusum_;
   DriftReference drift_;
   Ring<RegimeEntry> regime_;  // the latest kRegimeBlocks judged or excluded blocks
+  std::array<OtherRegime, kMaxOtherRegimes> others_{};
+  std::size_t other_count_ = 0;
+  int judging_other_ = -1;
+  // Whether other programs are learned; off for a state from a build before it (judges as then).
+  bool learns_other_regimes_ = true;
+  // The blocks of an unrecognised program so far, and their longest runs [hops].
+  std::vector<Block> candidate_;  // reserved at construction
+  std::size_t candidate_rest_run_ = 0, candidate_motion_run_ = 0;
 };
 
 }  // namespace leakmon::detect

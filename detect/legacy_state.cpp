@@ -346,10 +346,42 @@ DetectorState feature_test_from_lorden(const DetectorState& old, int version,
   return c.out();
 }
 
+// The feature test before it learned other programs (index_cusum 6, detail_xcorr 5, and the
+// layouts before once converted to them): no other regime, and it learns none, so it judges as
+// that build did (the first program only). The regime ring's blocks have no activity.
+DetectorState feature_test_from_one_regime(const DetectorState& old, int version,
+                                           std::string_view prefix) {
+  Conversion c(old, version);
+  for (const auto& [key, values] : old.entries()) c.put(key, values);
+  const auto key = [prefix](std::string_view name) { return state_key(prefix, name); };
+  const std::size_t ring = c.list(key("regime.blocks.t")).size();
+  c.put(key("regime.blocks.activity"), std::vector<double>(ring, kNaN));
+  for (const char* field :
+       {"constant", "load", "load_squared", "log_activity", "sigma", "reference", "rest_low",
+        "rest_high", "activity_low", "activity_high", "longest_rest", "longest_motion"}) {
+    c.put(key(std::string("others.") + field), std::span<const double>());
+  }
+  c.put(key("others.judging"), -1.0);
+  c.put(key("others.learns"), 0.0);
+  for (const char* field : {"t", "feature", "load", "load_squared", "log_activity", "log_friction",
+                            "log_supply", "rest_share"}) {
+    c.put(key(std::string("others.candidate.") + field), std::span<const double>());
+  }
+  c.out().put_count(key("others.candidate_rest_run"), 0);
+  c.out().put_count(key("others.candidate_motion_run"), 0);
+  return c.out();
+}
+
 }  // namespace
 
 DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
   if (state.kind() == kind && state.version() == version) return state;
+  if (state.kind() == kind && kind == "index_cusum" && version == 7 && state.version() < 7) {
+    return feature_test_from_one_regime(upgraded_state(state, kind, 6), 7, "");
+  }
+  if (state.kind() == kind && kind == "detail_xcorr" && version == 6 && state.version() < 6) {
+    return feature_test_from_one_regime(upgraded_state(state, kind, 5), 6, "test");
+  }
   if (state.kind() == kind && kind == "detail_xcorr" && version == 5 && state.version() < 5) {
     return feature_test_from_lorden(upgraded_state(state, kind, 4), 5, "test");
   }

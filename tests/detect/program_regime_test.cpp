@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <iterator>
 #include <memory>
 #include <string>
 
 #include "config/yaml_reader.hpp"
 #include "detect/factory.hpp"
+#include "detect/feature_test.hpp"
 #include "tests/detect/synthetic_rig.hpp"
 
 namespace leakmon::detect {
@@ -46,12 +48,14 @@ Decision after_a_hold(const char* options, double hold_s, double until_s) {
   return d;
 }
 
-// A durability block: a 0.5 Hz, 20 mm sine, which rings the mode at 0.6 of the steps' level
-// (above the no_excitation share). steps_again() hands the rig back to its steps.
-Observation sine(test::SyntheticRig& rig) {
-  rig.target = 0.02 * std::sin(2.0 * 3.141592653589793 * 0.5 * (rig.t + rig.hop));
+// A durability block: a sine of `amplitude` [m] at `hz`, which rings the mode at `share` of the
+// steps' level; by default 0.5 Hz, 20 mm at 0.6 (above the no_excitation share).
+// steps_again() hands the rig back to its steps.
+Observation sine(test::SyntheticRig& rig, double amplitude = 0.02, double hz = 0.5,
+                 double share = 0.6) {
+  rig.target = amplitude * std::sin(2.0 * 3.141592653589793 * hz * (rig.t + rig.hop));
   rig.hold_left = 1e9;
-  return rung(rig, 0.6);
+  return rung(rig, share);
 }
 void steps_again(test::SyntheticRig& rig) { rig.hold_left = 0.0; }
 
@@ -98,7 +102,8 @@ TEST(PressureOnlyPrograms, AHoldBeyondTheLongestWaitCannotLearn) {
   EXPECT_TRUE(std::isnan(d.score));
 }
 
-// Learned on steps; then two minutes of a sine block, then the steps again.
+// Learned on steps; then two minutes of a sine block, then the steps again. Its first learning
+// period (90 s) is not judged: after it the sine is a regime of its own (see below).
 struct ExcursionRun {
   double max_score = 0.0;
   std::size_t outside = 0, hops = 0;
@@ -109,8 +114,10 @@ ExcursionRun run_excursion(Detector& detector, test::SyntheticRig& rig) {
   while (rig.t < 200.0) detector.update(rig.next());
   while (rig.t < 320.0) {
     r.last = detector.update(sine(rig));
-    ++r.hops;
-    if (r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) ++r.outside;
+    if (rig.t < 290.0) {
+      ++r.hops;
+      if (r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) ++r.outside;
+    }
     if (!std::isnan(r.last.score)) r.max_score = std::max(r.max_score, r.last.score);
   }
   steps_again(rig);
@@ -222,7 +229,7 @@ TEST(PressureOnlyPrograms, AStateFromBeforeTheRunTestJudgesTheHoldAsThen) {
   }
   auto converted = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
   converted->import_state(before);
-  EXPECT_EQ(converted->export_state().version(), 6);
+  EXPECT_EQ(converted->export_state().version(), 7);
   EXPECT_GE(hold_after_steps(*converted, rig).max_score, 1.0);
 }
 
@@ -257,6 +264,213 @@ TEST(PressureOnlyPrograms, ALearningPeriodWithASineInItIsDiscarded) {
   }
   EXPECT_GT(learned_at, 40.0 + 90.0 - 1.0);  // not on the first period
   EXPECT_LT(learned_at, 40.0 + 90.0 + 5.0);  // a period begun with the steps
+}
+
+// Per-regime learning: a program other than the steps that lasts a learning period and rings
+// the mode is learned as a regime of its own and judged by its own baseline; a leak lowers the
+// index there as in the steps. The sine rings the mode at 0.6 of the steps' level: judged by
+// the steps' baseline that reads as a leak (WithoutTheRegimeTestTheOtherProgramRaises).
+struct SineRun {
+  double max_healthy_score = 0.0;
+  double first_raise = -1.0;
+  // In the sine, from when it was first said outside the learned regime or learning (the first
+  // blocks of a new program are judged until the regime ring shows it, and taken back then).
+  double first_judged = -1.0;
+  std::size_t judged = 0, hops = 0;  // in the sine after its first 15 s
+  bool said_outside = false;
+  Decision last;
+};
+// Steps until `sine_from`, then the default sine until `until`; the rig's onset and drop apply.
+SineRun steps_then_sine(Detector& detector, test::SyntheticRig& rig, double sine_from,
+                        double until) {
+  SineRun r;
+  while (rig.t < until) {
+    const bool in_sine = rig.t >= sine_from;
+    r.last = detector.update(in_sine ? sine(rig) : rig.next());
+    if (in_sine) {
+      if (r.last.learning || r.last.not_judged_reason == NotJudgedReason::outside_learned_regime) {
+        r.said_outside = true;
+      }
+      if (rig.t > sine_from + 15.0) {
+        ++r.hops;
+        if (r.last.judged) ++r.judged;
+      }
+      if (r.said_outside && r.last.judged && r.first_judged < 0.0) r.first_judged = rig.t;
+    }
+    if (std::isnan(r.last.score)) continue;
+    if (rig.t < rig.onset) r.max_healthy_score = std::max(r.max_healthy_score, r.last.score);
+    if (r.first_raise < 0.0 && r.last.score >= 1.0) r.first_raise = rig.t;
+  }
+  return r;
+}
+
+TEST(PressureOnlyPrograms, ASineThatLastsALearningPeriodIsLearnedAndJudged) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  const SineRun r = steps_then_sine(*detector, rig, 200.0, 600.0);
+  EXPECT_LT(r.max_healthy_score, 1.0);
+  // Learned after one learning period of the sine (90 s) and the regime ring (6.4 s).
+  EXPECT_GT(r.first_judged, 200.0 + 90.0);
+  EXPECT_LT(r.first_judged, 200.0 + 90.0 + 15.0);
+  EXPECT_GT(static_cast<double>(r.judged), 0.6 * static_cast<double>(r.hops));
+  EXPECT_TRUE(r.last.judged);
+}
+
+TEST(PressureOnlyPrograms, ALeakInALearnedSineIsFound) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 400.0;
+  rig.index_drop = 0.3;
+  const SineRun r = steps_then_sine(*detector, rig, 200.0, 500.0);
+  EXPECT_LT(r.max_healthy_score, 1.0);
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 60.0);
+}
+
+// The sine learned in its first block is told again when it returns after the steps: judged
+// within seconds, a leak in it found within 60 s, and the steps between judged by theirs.
+TEST(PressureOnlyPrograms, ALearnedSineIsToldAgainWhenItReturns) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 480.0;
+  rig.index_drop = 0.3;
+  steps_then_sine(*detector, rig, 200.0, 330.0);
+  steps_again(rig);
+  const SineRun steps = steps_then_sine(*detector, rig, 1e9, 430.0);
+  EXPECT_LT(steps.max_healthy_score, 1.0);
+  EXPECT_TRUE(steps.last.judged);
+  const SineRun again = steps_then_sine(*detector, rig, 430.0, 560.0);
+  EXPECT_LT(again.max_healthy_score, 1.0);
+  EXPECT_GT(again.first_judged, 430.0);
+  EXPECT_LT(again.first_judged, 430.0 + 15.0);
+  EXPECT_GT(again.first_raise, rig.onset);
+  EXPECT_LT(again.first_raise, rig.onset + 60.0);
+}
+
+// Another sine (twice the amplitude, ringing the mode less) is not the learned one: it is not
+// judged by that baseline (it would read as a leak) until it has been learned itself.
+TEST(PressureOnlyPrograms, AnotherSineIsNotJudgedByTheLearnedOne) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  steps_then_sine(*detector, rig, 200.0, 330.0);
+  double max_score = 0.0;
+  std::size_t judged = 0;
+  while (rig.t < 400.0) {
+    const Decision d = detector->update(sine(rig, 0.04, 0.5, 0.4));
+    if (rig.t > 345.0 && d.judged) ++judged;
+    if (!std::isnan(d.score)) max_score = std::max(max_score, d.score);
+  }
+  EXPECT_EQ(judged, 0U);
+  EXPECT_LT(max_score, 1.0);
+}
+
+// At most kMaxOtherRegimes programs are learned besides the steps: a fourth sine stays
+// `outside_learned_regime`.
+TEST(PressureOnlyPrograms, OtherRegimesAreBounded) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  while (rig.t < 200.0) detector->update(rig.next());
+  const double amplitudes[] = {0.005, 0.01, 0.02, 0.04};
+  static_assert(std::size(amplitudes) == FeatureTest::kMaxOtherRegimes + 1);
+  Decision d;
+  std::size_t judged_in_last = 0;
+  for (const double amplitude : amplitudes) {
+    const double end = rig.t + 130.0;
+    while (rig.t < end) {
+      d = detector->update(sine(rig, amplitude, 0.5, 0.6));
+      if (amplitude == amplitudes[3] && rig.t > end - 115.0 && d.judged) ++judged_in_last;
+    }
+  }
+  EXPECT_EQ(judged_in_last, 0U);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::outside_learned_regime);
+}
+
+// A state saved while the sine is being learned, and one saved while it is judged, decide as
+// the original.
+TEST(PressureOnlyPrograms, StatesSavedWhileLearningAndJudgingASineRoundTrip) {
+  for (const double saved_at : {250.0, 350.0}) {
+    auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+    test::SyntheticRig rig;
+    rig.onset = 400.0;
+    rig.index_drop = 0.3;
+    steps_then_sine(*detector, rig, 200.0, saved_at);
+    auto copy = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+    copy->import_state(detector->export_state());
+    std::size_t judged = 0;
+    while (rig.t < 450.0) {
+      const Observation o = sine(rig);
+      const Decision a = detector->update(o);
+      const Decision b = copy->update(o);
+      ASSERT_EQ(a.judged, b.judged) << saved_at << " " << o.t;
+      ASSERT_EQ(a.not_judged_reason, b.not_judged_reason) << o.t;
+      if (a.judged) ++judged;
+      if (!std::isnan(a.score)) {
+        ASSERT_EQ(a.score, b.score) << o.t;
+      }
+    }
+    EXPECT_GT(judged, 0U);
+  }
+}
+
+// A state of the layout before (index_cusum 6: one regime) loads as layout 7 and learns no
+// other program, as that build did: the sine stays outside the learned regime.
+TEST(PressureOnlyPrograms, AStateFromBeforeLearnsNoOtherProgram) {
+  auto original = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  while (rig.t < 150.0) original->update(rig.next());
+  const DetectorState now = original->export_state();
+  DetectorState before("index_cusum", 6);
+  for (const auto& [key, values] : now.entries()) {
+    if (!key.starts_with("others.") && key != "regime.blocks.activity") before.put(key, values);
+  }
+  auto converted = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  converted->import_state(before);
+  EXPECT_EQ(converted->export_state().version(), 7);
+  const SineRun r = steps_then_sine(*converted, rig, 200.0, 500.0);
+  EXPECT_EQ(r.judged, 0U);
+  EXPECT_EQ(r.last.not_judged_reason, NotJudgedReason::outside_learned_regime);
+}
+
+// A shift that begins with a durability block: before any steps the sine is learned and judged
+// by its own baseline (a leak in it found within 60 s), while the steps' learning waits; the
+// steps that follow are learned as before, and the sine is told again after them.
+TEST(PressureOnlyPrograms, ASineBeforeAnyStepsIsLearnedAndJudged) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  const SineRun sine_first = steps_then_sine(*detector, rig, 0.0, 200.0);
+  EXPECT_LT(sine_first.max_healthy_score, 1.0);
+  EXPECT_GT(sine_first.first_judged, 90.0);
+  EXPECT_LT(sine_first.first_judged, 90.0 + 20.0);
+  EXPECT_TRUE(sine_first.last.judged);
+  steps_again(rig);
+  double learned_at = -1.0;
+  Decision d;
+  while (rig.t < 400.0) {
+    d = detector->update(rig.next());
+    if (learned_at < 0.0 && !d.learning && d.judged && rig.t > 215.0) learned_at = rig.t;
+    if (!std::isnan(d.score)) {
+      EXPECT_LT(d.score, 1.0) << rig.t;
+    }
+  }
+  EXPECT_LT(learned_at, 200.0 + 90.0 + 10.0);
+  rig.onset = 440.0;
+  rig.index_drop = 0.3;
+  const SineRun again = steps_then_sine(*detector, rig, 400.0, 520.0);
+  EXPECT_LT(again.max_healthy_score, 1.0);
+  EXPECT_LT(again.first_judged, 400.0 + 15.0);
+  EXPECT_GT(again.first_raise, rig.onset);
+  EXPECT_LT(again.first_raise, rig.onset + 60.0);
+}
+
+TEST(PressureOnlyPrograms, ALeakInASineBeforeAnyStepsIsFound) {
+  auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
+  test::SyntheticRig rig;
+  rig.onset = 150.0;
+  rig.index_drop = 0.3;
+  const SineRun r = steps_then_sine(*detector, rig, 0.0, 260.0);
+  EXPECT_LT(r.max_healthy_score, 1.0);
+  EXPECT_GT(r.first_raise, rig.onset);
+  EXPECT_LT(r.first_raise, rig.onset + 60.0);
 }
 
 }  // namespace
