@@ -292,19 +292,28 @@ void FeatureTest::finish_learning() {
   for (const auto& b : learned_) {
     if (std::isnan(b.rest_share)) return;  // blocks of a state from before issue 23
   }
-  double low = 1.0, high = 0.0, sum = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    sum += learned_[i].rest_share;
-    if (i >= kRegimeBlocks) sum -= learned_[i - kRegimeBlocks].rest_share;
-    if (i + 1 < kRegimeBlocks) continue;
-    const double mean = sum / static_cast<double>(kRegimeBlocks);
-    low = std::min(low, mean);
-    high = std::max(high, mean);
-  }
-  learned_rest_low_ = low;
-  learned_rest_high_ = high;
+  const WindowRange rest = window_mean_range(learned_, &Block::rest_share);
+  learned_rest_low_ = rest.low;
+  learned_rest_high_ = rest.high;
   learned_longest_rest_ = static_cast<double>(learning_rest_run_) * hop_seconds();
   learned_longest_motion_ = static_cast<double>(learning_motion_run_) * hop_seconds();
+}
+
+// The lowest and highest mean of a block field over every kRegimeBlocks consecutive blocks (a
+// running sum; the blocks hold at least kRegimeBlocks).
+FeatureTest::WindowRange FeatureTest::window_mean_range(std::span<const Block> blocks,
+                                                        double Block::*field) {
+  WindowRange range{1e300, -1e300};
+  double sum = 0.0;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    sum += blocks[i].*field;
+    if (i >= kRegimeBlocks) sum -= blocks[i - kRegimeBlocks].*field;
+    if (i + 1 < kRegimeBlocks) continue;
+    const double mean = sum / static_cast<double>(kRegimeBlocks);
+    range.low = std::min(range.low, mean);
+    range.high = std::max(range.high, mean);
+  }
+  return range;
 }
 
 void FeatureTest::count_run(bool at_rest) {
@@ -479,24 +488,10 @@ void FeatureTest::learn_other(const Block& block) {
   candidate_rest_run_ = std::max(candidate_rest_run_, completed_rest_run_);
   candidate_motion_run_ = std::max(candidate_motion_run_, completed_motion_run_);
   if (candidate_.size() >= kRegimeBlocks) {
-    double share_low = 1e300, share_high = -1e300, activity_low = 1e300, activity_high = -1e300;
-    double share = 0.0, activity = 0.0;
-    for (std::size_t i = 0; i < candidate_.size(); ++i) {
-      share += candidate_[i].rest_share;
-      activity += candidate_[i].log_activity;
-      if (i >= kRegimeBlocks) {
-        share -= candidate_[i - kRegimeBlocks].rest_share;
-        activity -= candidate_[i - kRegimeBlocks].log_activity;
-      }
-      if (i + 1 < kRegimeBlocks) continue;
-      const double n = static_cast<double>(kRegimeBlocks);
-      share_low = std::min(share_low, share / n);
-      share_high = std::max(share_high, share / n);
-      activity_low = std::min(activity_low, activity / n);
-      activity_high = std::max(activity_high, activity / n);
-    }
-    if (share_high - share_low > 2.0 * options_.regime_tolerance ||
-        activity_high - activity_low > 2.0 * kActivityTolerance) {
+    const WindowRange share = window_mean_range(candidate_, &Block::rest_share);
+    const WindowRange activity = window_mean_range(candidate_, &Block::log_activity);
+    if (share.high - share.low > 2.0 * options_.regime_tolerance ||
+        activity.high - activity.low > 2.0 * kActivityTolerance) {
       const auto keep = static_cast<std::ptrdiff_t>(kRegimeBlocks / 2);
       candidate_.erase(candidate_.begin(), candidate_.end() - keep);
       candidate_rest_run_ = completed_rest_run_;
@@ -612,23 +607,12 @@ void FeatureTest::finish_other() {
       clock_.learned() && !cannot_learn_ && block_sigma_ > 0.0
           ? drift_.reference(candidate_.back().t, block_sigma_, temperature_seen_, anchored_until())
           : 0.0;
-  r.rest_low = r.activity_low = 1e300;
-  r.rest_high = r.activity_high = -1e300;
-  double share = 0.0, activity = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    share += candidate_[i].rest_share;
-    activity += candidate_[i].log_activity;
-    if (i >= kRegimeBlocks) {
-      share -= candidate_[i - kRegimeBlocks].rest_share;
-      activity -= candidate_[i - kRegimeBlocks].log_activity;
-    }
-    if (i + 1 < kRegimeBlocks) continue;
-    const double k = static_cast<double>(kRegimeBlocks);
-    r.rest_low = std::min(r.rest_low, share / k);
-    r.rest_high = std::max(r.rest_high, share / k);
-    r.activity_low = std::min(r.activity_low, activity / k);
-    r.activity_high = std::max(r.activity_high, activity / k);
-  }
+  const WindowRange share = window_mean_range(candidate_, &Block::rest_share);
+  const WindowRange activity = window_mean_range(candidate_, &Block::log_activity);
+  r.rest_low = share.low;
+  r.rest_high = share.high;
+  r.activity_low = activity.low;
+  r.activity_high = activity.high;
   r.longest_rest = static_cast<double>(candidate_rest_run_) * hop_seconds();
   r.longest_motion = static_cast<double>(candidate_motion_run_) * hop_seconds();
   others_[other_count_++] = r;

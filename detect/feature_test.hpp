@@ -64,6 +64,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -195,6 +196,10 @@ class FeatureTest {
       record_field<&Block::log_friction>("log_friction"),
       record_field<&Block::log_supply>("log_supply"),
       record_field<&Block::rest_share>("rest_share")};
+  struct WindowRange {
+    double low, high;
+  };
+  static WindowRange window_mean_range(std::span<const Block> blocks, double Block::*field);
   // A block of the regime test: its share of hops at rest, and its feature residual
   // waiting to enter the drift reference (NaN: it does not) until kRegimeBlocks later blocks
   // showed no excursion.
