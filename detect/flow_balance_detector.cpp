@@ -302,6 +302,7 @@ void FlowBalanceDetector::probe_learned_change() {
   SlopeStepOptions options;
   options.floor_slope = std::max(floor_slope_, design_slope_);
   options.slope_to_coefficient = options_.rig.Kv / std::sqrt(options_.rig.ps);
+  options.fitted_terms = kTerms;
   learned_change_ = find_slope_step(probe_blocks_, reference_blocks, options);
 }
 

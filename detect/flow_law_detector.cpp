@@ -297,6 +297,7 @@ void FlowLawDetector::probe_learned_change() {
   options.floor_slope = std::max(floor_slope_, design_slope_) * reference[0];
   options.slope_to_coefficient = flow_unit_ / options_.rig.ps / reference[0];
   options.feature = "flow_residual";
+  options.fitted_terms = kRegressors;
   learned_change_ = find_slope_step(probe_blocks_, reference_blocks.size(), options);
 }
 

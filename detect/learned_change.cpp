@@ -11,7 +11,12 @@ namespace leakmon::detect {
 std::optional<LearnedChange> find_slope_step(std::span<const ResidualBlock> blocks,
                                              std::size_t reference_blocks,
                                              const SlopeStepOptions& options) {
-  if (reference_blocks < 3 || blocks.size() < reference_blocks + options.min_blocks_after) {
+  // A reference of hardly more blocks than the fitted terms is fitted almost exactly, whatever
+  // the noise: a 12 s learning period gave 6 blocks for the flow balance's 6 terms and a healthy
+  // rig's step came out at 70 standard errors.
+  const std::size_t fitted = std::max<std::size_t>(options.fitted_terms, 1);
+  if (reference_blocks < fitted + kMinReferenceDof ||
+      blocks.size() < reference_blocks + options.min_blocks_after) {
     return std::nullopt;
   }
   // The spread of a block mean around the reference fit, as the AR(1) long-run one: the blocks
@@ -22,9 +27,9 @@ std::optional<LearnedChange> find_slope_step(std::span<const ResidualBlock> bloc
     if (i > 0) sum_lag += blocks[i].residual * blocks[i - 1].residual;
   }
   if (!(sum_sq > 0.0)) return std::nullopt;
-  const double sigma =
-      cusum_block_sigma(std::sqrt(sum_sq / static_cast<double>(reference_blocks - 1)),
-                        reference_blocks, lag_one_correlation(sum_lag, sum_sq));
+  const std::size_t dof = reference_blocks - fitted;
+  const double sigma = cusum_block_sigma(std::sqrt(sum_sq / static_cast<double>(dof)), dof + 1,
+                                         lag_one_correlation(sum_lag, sum_sq));
   // The added slope after each candidate block k, by least squares over the blocks from k on;
   // scanned backwards so each candidate costs one step.
   std::optional<LearnedChange> best;

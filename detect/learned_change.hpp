@@ -23,6 +23,8 @@ namespace leakmon::detect {
 
 // The share of the learning period, from its start, that serves as the reference.
 inline constexpr double kReferenceShare = 0.4;
+// Residual degrees of freedom a reference needs to estimate its own spread.
+inline constexpr std::size_t kMinReferenceDof = 4;
 
 struct LearnedChange {
   double change_t = 0.0;     // estimated source time of the step [s]
@@ -54,6 +56,10 @@ struct SlopeStepOptions {
   // of one hold are correlated, so well above a single test's.
   double min_z = 6.0;
   std::size_t min_blocks_after = 4;  // a step must hold for this many blocks
+  // Terms of the healthy relation fitted to the reference blocks: they take that many degrees of
+  // freedom from the reference's spread, and a reference with fewer than kMinReferenceDof left
+  // cannot say what a step's significance is.
+  std::size_t fitted_terms = 0;
   // The residual's name in the event: the at-rest balance's command or flow_law's flow.
   std::string_view feature = "command_residual";
 };

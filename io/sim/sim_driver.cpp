@@ -59,10 +59,16 @@ void SimDriver::start() {
   if (settings_.leak)
     rig_->set_internal_leak(settings_.leak->C_L, settings_.leak->onset_s, settings_.leak->ramp_s);
   source_time_.reset();
+  rig_tick_ = 0;
 }
 
-ReadStatus SimDriver::read(const Tick& /*tick*/, std::span<double> values) noexcept {
+ReadStatus SimDriver::read(const Tick& tick, std::span<double> values) noexcept {
+  for (std::uint64_t caught_up = 0; rig_tick_ < tick.index && caught_up < kSimMaxCatchUpSteps;
+       ++caught_up, ++rig_tick_) {
+    rig_->step();
+  }
   const sim::RigSample sample = rig_->step();
+  ++rig_tick_;
   for (std::size_t i = 0; i < fields_.size() && i < values.size(); ++i) {
     values[i] = field(sample, fields_[i]);
   }

@@ -1,9 +1,14 @@
 // The `sim` driver: the rig model of sim/ (MODEL.md) stepped once per tick, so the daemon can
 // run against a simulated actuator in real time. The scenario is a preset or a scenario file;
 // an internal leak can be injected at a given simulated time. source_time() is the rig's t.
+// Like a real rig, the simulated one does not wait for the daemon: ticks the loop missed are
+// stepped through (their samples lost, as a real transducer's would be), so the rig's time stays
+// the tick's time and a leak set to open at 40 s opens 40 s after the start however loaded the
+// machine is.
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,7 +57,13 @@ class SimDriver final : public Driver {
   std::vector<std::size_t> fields_;  // index into kSimChannels per channel
   std::unique_ptr<sim::Rig> rig_;
   std::optional<double> source_time_;
+  std::uint64_t rig_tick_ = 0;  // the tick whose sample the rig's next step() returns
 };
+
+// Missed ticks stepped through per read at most: a stall of seconds is made up over the next
+// reads instead of in one read long enough to make the next cycle late too (a step costs a few
+// microseconds).
+inline constexpr std::uint64_t kSimMaxCatchUpSteps = 100;
 
 // `{name, type: sim, scenario: PRESET|FILE.yaml, seed, leak: {C_L | lpm_per_mpa, onset_s,
 // ramp_s}, channels}`.

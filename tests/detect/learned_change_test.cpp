@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <span>
 #include <vector>
 
 namespace leakmon::detect {
@@ -57,6 +58,29 @@ TEST(SlopeStep, TooLittleDataIsNoVerdict) {
   const auto blocks = residual_blocks(3.0, 70.0, 1);
   EXPECT_FALSE(find_slope_step({blocks.data(), 2}, 2, slope_options()));
   EXPECT_FALSE(find_slope_step({blocks.data(), 42}, 40, slope_options()));
+}
+
+// A reference of 6 blocks fitted with 6 terms leaves residuals near zero whatever the noise (a
+// 12 s learning period on a healthy rig with gaps: a step of 70 standard errors). The fitted
+// terms take their degrees of freedom from the spread; too few left is no verdict.
+TEST(SlopeStep, AReferenceFittedAlmostExactlyIsNoVerdict) {
+  // A reference fitted to 1e-3 of the noise, and the fit extrapolated to the next loads, off by
+  // a slope as large as a leak's.
+  auto blocks = residual_blocks(1.5, 6.0, 4);
+  for (std::size_t i = 0; i < 6; ++i) blocks[i].residual *= 1e-3;
+  SlopeStepOptions options = slope_options();
+  std::span<const ResidualBlock> short_period(blocks.data(), 16);
+  const auto noise_as_step = find_slope_step(short_period, 6, options);  // the fit's terms ignored
+  ASSERT_TRUE(noise_as_step.has_value());
+  EXPECT_GT(noise_as_step->z, 50.0);
+  options.fitted_terms = 6;
+  EXPECT_FALSE(find_slope_step(short_period, 6, options).has_value());
+  // With enough reference blocks the fitted terms cost a little spread, and a real step shows.
+  const auto stepped = residual_blocks(3.0, 70.0, 1);
+  EXPECT_TRUE(find_slope_step(stepped, 40, options).has_value());
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    EXPECT_FALSE(find_slope_step(residual_blocks(0.0, 0.0, seed), 40, options));
+  }
 }
 
 // 90 s of learning at 10 hops a second, an index of 20 kPa with hop noise and a slow wobble.

@@ -50,5 +50,29 @@ TEST(SimDriverChannels, RecordedTransducersAndFaultsReachTheDriver) {
   EXPECT_THROW(SimDriver{settings}, DriverError);
 }
 
+// A real rig does not pause while the daemon misses cycles: the simulated one steps through the
+// missed ticks, so its time stays the tick's time (before, a loaded machine delayed a leak set to
+// open at 40 s by every missed cycle, and the daemon's samples around a gap joined without one).
+TEST(SimDriverTime, TheRigKeepsRunningThroughMissedTicks) {
+  SimSettings settings;
+  settings.scenario = sim::preset("healthy", 3);
+  SimDriver driver(settings);
+  driver.start();
+  std::vector<double> values(driver.channels().size());
+  constexpr double kPeriod = 0.002;
+  test::AllocationScope scope;
+  for (std::uint64_t k = 0; k < 10; ++k) ASSERT_EQ(driver.read(Tick{k, 0}, values), ReadStatus::ok);
+  EXPECT_NEAR(*driver.source_time(), 9 * kPeriod, 1e-9);
+  ASSERT_EQ(driver.read(Tick{60, 0}, values), ReadStatus::ok);  // 50 ticks missed
+  EXPECT_NEAR(*driver.source_time(), 60 * kPeriod, 1e-9);
+  // A stall of 1000 ticks is made up at most kSimMaxCatchUpSteps per read.
+  ASSERT_EQ(driver.read(Tick{1061, 0}, values), ReadStatus::ok);
+  EXPECT_NEAR(*driver.source_time(), (61 + kSimMaxCatchUpSteps) * kPeriod, 1e-9);
+  std::uint64_t tick = 1062;
+  for (; tick < 1200; ++tick) ASSERT_EQ(driver.read(Tick{tick, 0}, values), ReadStatus::ok);
+  EXPECT_NEAR(*driver.source_time(), 1199 * kPeriod, 1e-9);
+  EXPECT_EQ(scope.count(), 0u);
+}
+
 }  // namespace
 }  // namespace leakmon::io

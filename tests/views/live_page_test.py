@@ -11,6 +11,11 @@ pressure-only actuator on a rig held by seal friction must show the "blind" badg
 learned, and the first actuator must not. Optionally saves
 a screenshot with the raised alarm (docs/figures/live-page.png is made this way).
 
+The sampling loop asks for SCHED_FIFO as on a rig PC (granted to root, as in CI; otherwise the
+daemon warns and runs with normal scheduling): on a loaded machine with normal scheduling the
+loop missed thousands of cycles, each a gap that voids the press's index windows, and the press
+then had not finished learning (nor said it is blind) when the test looked.
+
     live_page_test.py --leakmon build/bin/leakmon --workdir DIR [--screenshot FILE.png]
 """
 import argparse
@@ -46,7 +51,7 @@ drivers:
     type: sim
     scenario: {friction_scenario}
 sampling:
-  - {{name: main, period_ms: 2, drivers: [rig, press_rig], priority: 0}}
+  - {{name: main, period_ms: 2, drivers: [rig, press_rig], priority: 40}}
 actuators:
   - name: cylinder
     channels: {{p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x, xref: rig.xref}}
@@ -131,8 +136,10 @@ def main():
         leak = card.find_element(By.CSS_SELECTOR, ".leak").text
         assert "±" in leak, f"leak size without its interval: {leak!r}"
         press = driver.find_element(By.ID, "actuator-press")
+        # The press decides it is blind from its learning period's index windows; on a loaded
+        # machine the loop's missed cycles are gaps that void windows, and learning takes longer.
         wait_for("the blind badge of the friction-held, pressure-only actuator",
-                 lambda: press.find_element(By.CSS_SELECTOR, ".badge.blind").is_displayed(), 15)
+                 lambda: press.find_element(By.CSS_SELECTOR, ".badge.blind").is_displayed(), 45)
         assert not card.find_element(By.CSS_SELECTOR, ".badge.blind").is_displayed(), \
             "the flow-balance actuator is shown blind"
         with open(events) as f:
