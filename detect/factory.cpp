@@ -395,6 +395,19 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               "learning waits until the learning blocks' mean loads p1 - p2 "
                               "spread this much (std) [Pa]",
                               [](O& o) -> double& { return o.min_load_spread; }),
+             number_option<O>("min_rest_loads", 0.0, 100.0,
+                              "... and until its blocks at rest lie at this many distinct loads, "
+                              "or its motion identifies the load term (min_motion_load_share); "
+                              "0: the spread alone",
+                              [](O& o) -> double& { return o.min_rest_loads; }),
+             number_option<O>("rest_load_tolerance", 1e3, 1e8,
+                              "rest loads p1 - p2 further apart than this are distinct [Pa]",
+                              [](O& o) -> double& { return o.rest_load_tolerance; }),
+             number_option<O>("min_motion_load_share", 0.0, 1.0,
+                              "with 3/4 of the learning blocks moving: the share of their load "
+                              "term's spread the swept and compressed volumes must leave "
+                              "unexplained (1 - R^2) for motion to identify it",
+                              [](O& o) -> double& { return o.min_motion_load_share; }),
              number_option<O>(
                  "min_load", 0.0, 1e9,
                  "a block whose mean load p1 - p2 is below this in size is not judged [Pa]",

@@ -63,6 +63,7 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
   reset_spool_time_constant();
   learned_.reserve(learn_capacity_);
   probe_blocks_.reserve(learn_capacity_);
+  rest_loads_.reserve(learn_capacity_);
 }
 
 void FlowLawDetector::reset_spool_time_constant() {
@@ -76,6 +77,7 @@ void FlowLawDetector::reset() {
   coefficients_.setZero();
   block_sigma_ = kMissing;
   waiting_ = false;
+  excitation_ = Excitation{};
   no_load_blocks_ = 0;
   reset_spool_time_constant();
   supply_ = viscosity_ratio_ = kMissing;
@@ -114,6 +116,7 @@ void FlowLawDetector::restart_block() {
   sum_flows_.fill(0.0);
   sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
+  block_max_speed_ = 0.0;
 }
 
 void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
@@ -167,6 +170,8 @@ Decision FlowLawDetector::update(const Observation& o) {
   // off, each read as a supply step), so the hops must have been still for
   // `supply_rest_seconds`.
   still_hops_ = std::abs(speed) < options_.rest_speed ? still_hops_ + 1 : 0;  // NaN: moving
+  // NaN (the hop after a gap) leaves the maximum; a NaN maximum (layout 3's block) stays.
+  block_max_speed_ = std::max(block_max_speed_, std::abs(speed));
   double reading = kMissing;
   if (!std::isnan(o.ps)) {
     reading = o.ps;
@@ -223,6 +228,7 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
              (sim::Parameters::nominal().beta * flow_unit_);
     b.length = block_length_;
     b.mean_load = sum_load_ / block_length_;
+    b.moving = block_max_speed_ < options_.rest_speed ? 0.0 : 1.0;
   }
   block_hop_ = 0;
   block_ok_ = have_previous_ && hop_usable_;
@@ -232,6 +238,7 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
   sum_flows_.fill(0.0);
   sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
+  block_max_speed_ = 0.0;
   if (!ok) {
     block_reason_ =
         !supply_tracker_.settled(t) ? NotJudgedReason::supply_settling : NotJudgedReason::data_gap;
@@ -248,8 +255,70 @@ void FlowLawDetector::learn(const Block& b) {
   if (learned_.size() == learn_capacity_) learned_.erase(learned_.begin());
   learned_.push_back(b);
   if (!clock_.period_over()) return;
-  waiting_ = !excited(learned_);
+  waiting_ = !identified();
   if (!waiting_) finish_learning();
+}
+
+bool FlowLawDetector::identified() {
+  excitation_ = Excitation{};
+  excitation_.blocks = learned_.size();
+  rest_loads_.clear();
+  for (const auto& b : learned_) {
+    if (b.moving != 0.0) {
+      ++excitation_.moving_blocks;
+    } else {
+      rest_loads_.push_back(b.mean_load);
+    }
+  }
+  // Distinct: further from the lowest load of the current group than the tolerance (as
+  // flow_balance groups its rest loads). Signed: a hold at +L and one at -L tell the load term
+  // from the offset as well as two loads of one sign.
+  std::sort(rest_loads_.begin(), rest_loads_.end());
+  for (std::size_t i = 0; i < rest_loads_.size();) {
+    std::size_t j = i;
+    while (j < rest_loads_.size() &&
+           rest_loads_[j] - rest_loads_[i] <= options_.rest_load_tolerance) {
+      ++j;
+    }
+    if (j - i >= kRestLoadBlocks) ++excitation_.rest_loads;
+    i = j;
+  }
+  const bool mostly_moving = static_cast<double>(excitation_.moving_blocks) >=
+                             kMotionBlockShare * static_cast<double>(excitation_.blocks);
+  if (mostly_moving) excitation_.motion_load_share = motion_load_share(learned_);
+  if (!excited(learned_)) return false;
+  if (options_.min_rest_loads <= 0.0) return true;
+  return static_cast<double>(excitation_.rest_loads) >= options_.min_rest_loads ||
+         (mostly_moving && excitation_.motion_load_share >= options_.min_motion_load_share);
+}
+
+// Over the moving blocks: the share of the load term's spread (about its mean) that the swept
+// volume, the compressed volume and the block's length (the offset) leave unexplained, 1 - R^2
+// of the load term regressed on them. The load coefficient is identified by what is left: in a
+// single sine the load follows the position and the compression closely (0.06), in steps,
+// sweeps and triangles it does not (0.96-1.00; docs/detection.md). The lag regressor is not
+// among them: it is not formed before the ladder's rung is chosen.
+double FlowLawDetector::motion_load_share(std::span<const Block> blocks) const {
+  LeastSquares<3> fit;
+  double sum = 0.0;
+  std::size_t moving = 0;
+  for (const auto& b : blocks) {
+    if (b.moving == 0.0) continue;
+    fit.add(Eigen::Vector3d(b.move, b.comp, b.length), b.load);
+    sum += b.load;
+    ++moving;
+  }
+  if (moving < 20) return kMissing;
+  const Eigen::Vector3d c = fit.solve();
+  const double mean = sum / static_cast<double>(moving);
+  double spread = 0.0, unexplained = 0.0;
+  for (const auto& b : blocks) {
+    if (b.moving == 0.0) continue;
+    const double r = b.load - c.dot(Eigen::Vector3d(b.move, b.comp, b.length));
+    unexplained += r * r;
+    spread += (b.load - mean) * (b.load - mean);
+  }
+  return spread > 0.0 ? std::min(unexplained / spread, 1.0) : kMissing;
 }
 
 // The cross-port term is identifiable only with several loads: a hold alone makes it collinear
@@ -530,6 +599,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("block.length", block_length_);
   state.put("block.ratio_sum", ratio_sum_);
   state.put_count("block.ratio_hops", ratio_hops_);
+  state.put("block.max_speed", block_max_speed_);
   state.put("sizing.weighted.rl", weighted_.rl);
   state.put("sizing.weighted.ll", weighted_.ll);
   state.put("sizing.since_change.rl", since_change_.rl);
@@ -601,6 +671,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     block_length_ = state.get("block.length");
     ratio_sum_ = state.get("block.ratio_sum");
     ratio_hops_ = state.get_count("block.ratio_hops");
+    block_max_speed_ = state.get("block.max_speed");
     weighted_ = SlopeSums{state.get("sizing.weighted.rl"), state.get("sizing.weighted.ll")};
     since_change_ =
         SlopeSums{state.get("sizing.since_change.rl"), state.get("sizing.since_change.ll")};

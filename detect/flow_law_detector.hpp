@@ -53,6 +53,15 @@ struct FlowLawOptions {
   // Learning finishes only when the block-mean loads p1 - p2 of the learning blocks spread at
   // least this much (standard deviation) [Pa].
   double min_load_spread = 0.3e6;
+  // ... and only when the learning blocks at rest lie at `min_rest_loads` loads p1 - p2 further
+  // apart than `rest_load_tolerance` [Pa] (steps), or when at least kMotionBlockShare of them move
+  // and their motion identifies the load term: the share of the moving blocks' load-term spread
+  // that the swept and compressed volumes and the block length do not explain is at least
+  // `min_motion_load_share` (sweeps, triangles; a single sine's load term is nearly a mix of the
+  // volumes: 0.06). 0 rest loads: the spread above alone (the build before issue 23's wait).
+  double min_rest_loads = 3.0;
+  double rest_load_tolerance = 0.3e6;
+  double min_motion_load_share = 0.9;
   // A block with |mean p1 - p2| below this is not judged (no load, no leak flow) [Pa].
   double min_load = 0.3e6;
   // Scaled by the factory with Kv / 3.39e-7, as flow_balance's.
@@ -90,8 +99,8 @@ class FlowLawDetector final : public Detector {
   double learning_seconds() const override {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
   }
-  // The learning period is over but the loads seen so far do not identify the model (a hold
-  // alone): waiting for excitation.
+  // The learning period is over but the blocks seen so far do not identify the model (a hold
+  // alone, a hold and a few seconds of motion, a single sine): waiting for excitation.
   bool waiting_for_excitation() const { return waiting_; }
   static constexpr int kRegressors = 5;
   using Coefficients = Eigen::Matrix<double, kRegressors, 1>;
@@ -105,7 +114,23 @@ class FlowLawDetector final : public Detector {
   // Layout 2 adds the time-constant ladder (layout 1 loads with the stated time constant kept);
   // layout 3 the hops at rest before the supply is read and the CUSUM's run for the change point
   // (layout 2 loads as long at rest and with an empty run).
-  static constexpr int kStateVersion = 3;
+  // Layout 4 marks the learning blocks at rest and the block in progress's fastest hop (layout 3's
+  // blocks load as moving, its block in progress as moving).
+  static constexpr int kStateVersion = 4;
+  // Motion alone identifies the load term only when at least this share of the learning blocks
+  // move: a long hold with a few seconds of a sweep has a sharp but biased load term.
+  static constexpr double kMotionBlockShare = 0.75;
+  // A rest load counts once this many blocks at rest lie at it (a second): the first steps after
+  // a long other program do not end learning on a window that is mostly that program.
+  static constexpr std::size_t kRestLoadBlocks = 5;
+  // What the latest check of the learning blocks found (diagnostics and tests): the distinct
+  // loads at rest and the motion's share of the load term (NaN: too few moving blocks).
+  struct Excitation {
+    std::size_t rest_loads = 0;
+    std::size_t moving_blocks = 0, blocks = 0;
+    double motion_load_share = kMissing;
+  };
+  Excitation excitation() const { return excitation_; }
   // The ladder (flow_law_ladder.hpp).
   static constexpr std::size_t kTauCandidates = detect::kTauCandidates;
   static constexpr std::size_t kStatedTau = detect::kStatedTau;
@@ -122,9 +147,10 @@ class FlowLawDetector final : public Detector {
     double length = kMissing;     // T
     double mean_load = kMissing;  // mean p1 - p2 [Pa]
     double lag = kMissing;        // d int qL dt per rung of the time-constant ladder
+    double moving = 1.0;          // 0: every hop of the block slower than rest_speed
     std::array<double, kTauCandidates> y_tau{};  // int qL dt per rung (read while learning)
   };
-  static constexpr std::array<RecordField<Block>, 8> block_fields() {
+  static constexpr std::array<RecordField<Block>, 9> block_fields() {
     return {record_field<&Block::t>("t"),
             record_field<&Block::y>("y"),
             record_field<&Block::move>("move"),
@@ -132,7 +158,8 @@ class FlowLawDetector final : public Detector {
             record_field<&Block::comp>("comp"),
             record_field<&Block::length>("length"),
             record_field<&Block::mean_load>("mean_load"),
-            record_field<&Block::lag>("lag")};
+            record_field<&Block::lag>("lag"),
+            record_field<&Block::moving>("moving")};
   }
   static Coefficients regressors(const Block& b) {
     return Coefficients(b.move, b.load, b.comp, b.length, b.lag);
@@ -152,6 +179,10 @@ class FlowLawDetector final : public Detector {
   void close_block(double t, bool past_settling);
   void learn(const Block& b);
   bool excited(std::span<const Block> blocks) const;
+  // Whether the learning blocks identify the model (excited, and the rest loads or the motion of
+  // min_rest_loads); sets excitation_. Uses rest_loads_.
+  bool identified();
+  double motion_load_share(std::span<const Block> blocks) const;
   void probe_learned_change();
   void finish_learning();
   void judge(const Block& b);
@@ -171,6 +202,8 @@ class FlowLawDetector final : public Detector {
   Coefficients coefficients_ = Coefficients::Zero();
   double block_sigma_ = kMissing;
   bool waiting_ = false;
+  Excitation excitation_;
+  std::vector<double> rest_loads_;  // scratch, reserved as learned_
   std::size_t no_load_blocks_ = 0;
   // What the status says: when a block was last judged, and why the latest one was not.
   double last_judged_t_ = kMissing;
@@ -201,6 +234,7 @@ class FlowLawDetector final : public Detector {
   std::array<double, kTauCandidates> sum_flows_{};
   double sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
   std::size_t ratio_hops_ = 0;
+  double block_max_speed_ = 0.0;  // the block's fastest hop [m/s] (NaN: unknown, moving)
   // The added slope on the load term: exponentially weighted, and from the change point on.
   struct SlopeSums {
     double rl = 0.0, ll = 0.0;

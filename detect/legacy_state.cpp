@@ -179,6 +179,18 @@ DetectorState flow_law_from_2(const DetectorState& old) {
   return out;
 }
 
+// flow_law 3 did not tell the learning blocks at rest from those that move (issue 23's wait for
+// excitation): its blocks load as moving, as does its block in progress (no fastest hop), so a
+// converted state waiting for excitation waits until motion identifies the load term or new
+// blocks at rest cover the loads. A state that had learned judges as it did.
+DetectorState flow_law_from_3(const DetectorState& old) {
+  DetectorState out(old.kind(), 4);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  out.put("learned.moving", std::vector<double>(old.get_list("learned.t").size(), 1.0));
+  out.put("block.max_speed", kNaN);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -413,6 +425,9 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() < 4 && version == 4) {
+      return flow_law_from_3(upgraded_state(state, kind, 3));
+    }
     if (kind == "flow_law" && state.version() == 1 && version == 3) {
       return flow_law_from_2(flow_law_from_1(state));
     }
