@@ -295,9 +295,10 @@ bool FlowLawDetector::identified() {
 // Over the moving blocks: the share of the load term's spread (about its mean) that the swept
 // volume, the compressed volume and the block's length (the offset) leave unexplained, 1 - R^2
 // of the load term regressed on them. The load coefficient is identified by what is left: in a
-// single sine the load follows the position and the compression closely (0.06), in steps,
-// sweeps and triangles it does not (0.96-1.00; docs/detection.md). The lag regressor is not
-// among them: it is not formed before the ladder's rung is chosen.
+// fast sine the volumes explain most of the load (1.5 Hz: 0.26), in triangles and steps hardly
+// any (0.99), in sweeps a third to a half (0.47-0.86) and in a slow sine, whose load follows the
+// spring in quadrature with the swept volume, none (1.0; docs/detection.md). The lag regressor
+// is not among them: it is not formed before the ladder's rung is chosen.
 double FlowLawDetector::motion_load_share(std::span<const Block> blocks) const {
   LeastSquares<3> fit;
   double sum = 0.0;

@@ -57,8 +57,8 @@ struct FlowLawOptions {
   // apart than `rest_load_tolerance` [Pa] (steps), or when at least kMotionBlockShare of them move
   // and their motion identifies the load term: the share of the moving blocks' load-term spread
   // that the swept and compressed volumes and the block length do not explain is at least
-  // `min_motion_load_share` (sweeps, triangles; a single sine's load term is nearly a mix of the
-  // volumes: 0.06). 0 rest loads: the spread above alone (the build before issue 23's wait).
+  // `min_motion_load_share` (triangles; a fast sine's load term is nearly a mix of the volumes).
+  // 0 rest loads: the spread above alone (the build before issue 23's wait).
   double min_rest_loads = 3.0;
   double rest_load_tolerance = 0.3e6;
   double min_motion_load_share = 0.9;
@@ -123,8 +123,9 @@ class FlowLawDetector final : public Detector {
   // A rest load counts once this many blocks at rest lie at it (a second): the first steps after
   // a long other program do not end learning on a window that is mostly that program.
   static constexpr std::size_t kRestLoadBlocks = 5;
-  // What the latest check of the learning blocks found (diagnostics and tests): the distinct
-  // loads at rest and the motion's share of the load term (NaN: too few moving blocks).
+  // What the latest check of the learning blocks found since construction, reset or restore
+  // (diagnostics and tests; not saved): the distinct loads at rest and the motion's share of the
+  // load term (NaN: under kMotionBlockShare moving, or too few).
   struct Excitation {
     std::size_t rest_loads = 0;
     std::size_t moving_blocks = 0, blocks = 0;
