@@ -170,6 +170,8 @@ double profile_error(const SegmentPredictor& predictor, std::span<const Segment>
                      double rise, const FitSettings& settings) {
   FitSettings pinned = settings;
   pinned.uncertainties = false;
+  // Each refit starts at the fit's optimum, a short way off: a few solver steps reach it.
+  pinned.max_iterations = std::min(settings.max_iterations, 5);
   pinned.free_calibration[static_cast<std::size_t>(index)] = false;
   // The effect's parameters start where the fit left them (their solver coordinates are
   // relative to `initial`).

@@ -215,10 +215,10 @@ TEST(Calibration, RecoversPerturbedParametersFromNoisyData) {
 // gradient: Gauss-Newton gave it a standard error of zero, and the drift test then called any
 // difference to it significant (docs/model-check.md, seed 796000). Its error is the profile's
 // curvature (how well the data pin it), not the clamp's zero: about the error the same data
-// give it where the bound does not bite (seen: 0.7-1.1 x over the residuals' RMS; the clamp
-// gave 0, the whole band would be about 1000 x). Kv, the value the data pin best (within 3 %
-// above), is stated 30 % high, so that its lower bound (-20 %) lies 4 % above the rig's own,
-// and then as it is.
+// give it where the bound does not bite, within 3 x either way (seen: 0.57-1.10 x over the
+// residuals' RMS in 16 draws; the clamp gave 0, the whole band would be about 1000 x). Kv, the
+// value the data pin best (within 3 % above), is stated 30 % high, so that its lower bound (-20 %)
+// lies 4 % above the rig's own, and then as it is.
 TEST(Calibration, ValueOnItsBoundHasTheProfilesErrorNotZero) {
   const auto seed = test::model_test_seed("Calibration.ValueOnItsBoundHasTheProfilesErrorNotZero");
   const SyntheticCase c = draw_case(seed, "none", {24.0});
@@ -247,8 +247,8 @@ TEST(Calibration, ValueOnItsBoundHasTheProfilesErrorNotZero) {
                        (inside.calibration_errors.Kv / std::sqrt(inside.cost));
   std::printf("  residual variance x %.2f; error over the residuals' RMS x %.2f\n",
               held.cost / inside.cost, ratio);
-  EXPECT_GT(ratio, 0.5);
-  EXPECT_LT(ratio, 2.0);
+  EXPECT_GT(ratio, 1.0 / 3.0);
+  EXPECT_LT(ratio, 3.0);
 }
 
 // The whole workflow on a short capture with a clear leak, cheap enough for the sanitizer
