@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace leakmon::model {
 
@@ -11,6 +12,27 @@ std::vector<Segment> segments_in_time_order(const SegmentPlan& plan) {
   std::sort(all.begin(), all.end(),
             [](const Segment& a, const Segment& b) { return a.begin < b.begin; });
   return all;
+}
+
+std::vector<std::size_t> moving_segments(const MeasuredRecord& record,
+                                         std::span<const Segment> segments, double share) {
+  std::vector<double> ranges;
+  for (const auto& seg : segments) {
+    const auto first = record.x.begin() + static_cast<std::ptrdiff_t>(seg.begin);
+    const auto [low, high] =
+        std::minmax_element(first, first + static_cast<std::ptrdiff_t>(seg.length));
+    ranges.push_back(*high - *low);
+  }
+  std::vector<std::size_t> out;
+  if (ranges.empty()) return out;
+  std::vector<double> sorted = ranges;
+  const auto rank = static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
+  const double threshold = share * sorted[static_cast<std::size_t>(rank)];
+  for (std::size_t i = 0; i < ranges.size(); ++i) {
+    if (ranges[i] > threshold) out.push_back(i);
+  }
+  return out;
 }
 
 std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,

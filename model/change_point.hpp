@@ -26,6 +26,14 @@ struct ChangePoint {
 // Every segment of a plan (fitting and held-out), in time order.
 std::vector<Segment> segments_in_time_order(const SegmentPlan& plan);
 
+// The indices of `segments` in which the piston moves: its position's range over the segment
+// is at least `share` of the 90th percentile of the segments' ranges (a step's transient, not
+// a hold's small corrections). An effect that shows only in motion (a slower spool, a dead
+// band, a supply droop) leaves the error of every hold as it was, and the holds, whose errors
+// follow the operating point, hide its onset in a split of all segments.
+std::vector<std::size_t> moving_segments(const MeasuredRecord& record,
+                                         std::span<const Segment> segments, double share = 0.25);
+
 // `log_errors[i]`: the log mean squared error of `segments[i]` (time order). Splits leave at
 // least `min_side` segments on either side. nullopt when there are too few segments.
 std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,

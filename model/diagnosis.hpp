@@ -113,11 +113,15 @@ struct DiagnosisSettings {
   double drift_effect_relative = 0.3;
   // Effects that start inside the capture: a change point of the nominal model's per-segment
   // errors, or of a leading screened effect's per-segment gain over it, with a Welch t of at
-  // least this (change_point.hpp) has the leading screened effects tried from it on too; a named
-  // one's onset is then searched within +-onset_search_s of it in steps of onset_step_s.
+  // least this (change_point.hpp) has every candidate that can start at a time (each variant)
+  // tried from it on too; a named one's onset is then searched within +-onset_search_s of it in
+  // steps of onset_step_s.
   double min_change_statistic = 5.0;
-  std::size_t onset_candidates = 4;
-  std::size_t change_candidates = 3;  // leading effects whose per-segment gain is split too
+  std::size_t onset_candidates = 4;   // leading screened effects, one variant each ...
+  std::size_t change_candidates = 3;  // ... of which these have their per-segment gain split
+  // The split is also sought among the segments in which the piston moves (change_point.hpp's
+  // moving_segments, this share of the 90th percentile of the segments' position ranges).
+  double moving_share = 0.25;
   double onset_search_s = 4.0;
   double onset_step_s = 0.05;
   // Trial onsets whose summed error lies within this share of the search's range (largest
