@@ -49,6 +49,12 @@ double reflected(double value, double lower, double upper) {
   return lower + (u <= width ? u : 2.0 * width - u);
 }
 
+// Calibrated value `index` (beta, Kv, m, b: the order of kLower and kUpper) of `c`.
+double& calibration_value(Calibration& c, int index) {
+  double* values[kCalibrationCount] = {&c.beta, &c.Kv, &c.m, &c.b};
+  return *values[index];
+}
+
 class SegmentFitProblem : public Eigen::DenseFunctor<double> {
  public:
   // Only the calibration parameters flagged in `free` are unknowns; the others stay at `start`.
@@ -84,11 +90,10 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   ModelParameters model(const InputType& theta) const {
     ModelParameters p;
     p.calibration = start_;
-    double* values[kCalibrationCount] = {&p.calibration.beta, &p.calibration.Kv, &p.calibration.m,
-                                         &p.calibration.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       if (calibration_slot_[i] < 0) continue;
-      *values[i] = std::clamp(theta[calibration_slot_[i]], kLower[i], kUpper[i]) * scales_[i];
+      calibration_value(p.calibration, i) =
+          std::clamp(theta[calibration_slot_[i]], kLower[i], kUpper[i]) * scales_[i];
     }
     if (candidate_) candidate_->apply(p, effect_values(theta));
     return p;
@@ -184,10 +189,7 @@ double profile_error(const SegmentPredictor& predictor, std::span<const Segment>
   }
   const EffectCandidate* refitted = warm ? &*warm : nullptr;
   const auto [lower, upper] = calibration_bounds(settings.stated);
-  const auto member = [index](Calibration& c) -> double& {
-    double* values[kCalibrationCount] = {&c.beta, &c.Kv, &c.m, &c.b};
-    return *values[index];
-  };
+  const auto member = [index](Calibration& c) -> double& { return calibration_value(c, index); };
   Calibration low = lower, high = upper;
   const double width = member(high) - member(low);
   if (!(rise > 0.0)) return width;
@@ -247,20 +249,18 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
     const Eigen::MatrixXd info = jacobian.transpose() * jacobian;
     const Eigen::MatrixXd cov = s2 * info.completeOrthogonalDecomposition().pseudoInverse();
     const auto err = [&](int j) { return std::sqrt(std::max(cov(j, j), 0.0)); };
-    double* errors[kCalibrationCount] = {
-        &result.calibration_errors.beta, &result.calibration_errors.Kv,
-        &result.calibration_errors.m, &result.calibration_errors.b};
     for (int i = 0; i < kCalibrationCount; ++i) {
       const int slot = problem.calibration_slot(i);
       if (slot < 0) {
-        *errors[i] = 0.0;
+        calibration_value(result.calibration_errors, i) = 0.0;
         continue;
       }
       const int side =
           bound_side(std::clamp(theta[slot], kLower[i], kUpper[i]), i, kBoundTolerance);
-      *errors[i] = side == 0 ? err(slot) * problem.scale(i)
-                             : profile_error(predictor, segments, candidate, result, i, side,
-                                             s2 / static_cast<double>(residuals.size()), settings);
+      calibration_value(result.calibration_errors, i) =
+          side == 0 ? err(slot) * problem.scale(i)
+                    : profile_error(predictor, segments, candidate, result, i, side,
+                                    s2 / static_cast<double>(residuals.size()), settings);
     }
     if (candidate) {
       for (std::size_t i = 0; i < candidate->parameters.size(); ++i) {

@@ -151,6 +151,11 @@ std::optional<double> ringing_beta(const SegmentPredictor& predictor, ModelParam
   return std::exp(0.5 * (lo + hi));
 }
 
+// Neither a ripple (found by its line) nor the oil (by its temperature) starts at a time.
+bool starts_at_a_time(const EffectCandidate& c) {
+  return c.effect != "supply_ripple" && c.effect != "oil_temperature";
+}
+
 }  // namespace
 
 NamedCause rig_cause(const RigFinding& finding) {
@@ -322,12 +327,11 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return screened[a].cost < screened[b].cost;
   });
-  // The leading screened effects, one variant each; neither a ripple (found by its line) nor
-  // the oil (by its temperature) starts at a time.
+  // The leading screened effects that can start at a time, one variant each.
   std::vector<std::size_t> leading;
   for (const std::size_t i : order) {
     const auto& base = library[i];
-    if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
+    if (!starts_at_a_time(base)) continue;
     const bool seen = std::any_of(leading.begin(), leading.end(),
                                   [&](std::size_t j) { return library[j].effect == base.effect; });
     if (!seen) leading.push_back(i);
@@ -369,7 +373,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // capture ranks below others that absorb part of its misfit everywhere (seed 796018's droop).
   if (d.change_point && d.change_point->statistic >= settings.min_change_statistic) {
     for (const auto& base : library) {
-      if (base.effect == "supply_ripple" || base.effect == "oil_temperature") continue;
+      if (!starts_at_a_time(base)) continue;
       EffectCandidate variant = base;
       variant.onset_s = d.change_point->t_s;
       screened.push_back(fit_model(predictor, screening_segments, &variant, catalogue, screening));
