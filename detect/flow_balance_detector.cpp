@@ -151,33 +151,50 @@ bool FlowBalanceDetector::on_flow_branch(const Hop& hop) const {
   return !(short_of_healthy > kOffBranchSigmas * hop_sigma_);
 }
 
-bool FlowBalanceDetector::excited_enough() {
-  // Loads of the blocks at rest (blocks grouped as in detection), in units of ps.
+FlowBalanceDetector::RestLoads FlowBalanceDetector::distinct_rest_loads(double side) {
+  // Loads of the hops at rest on this side, in units of ps. Hops, not block means: a block
+  // that holds the end of one rest and the start of the next has a mean load between two rests
+  // that was never held.
   scratch_.clear();
-  for (std::size_t i = 0; i < learned_.size();) {
+  for (const auto& rest : learned_) {
+    if (rest.load * side > 0.0) scratch_.push_back(rest.load);
+  }
+  std::sort(scratch_.begin(), scratch_.end());
+  // A group starts further from the lowest load of the current group than the tolerance, and
+  // counts once it holds a block's worth of hops at rest: a rest of a few hops is a move's
+  // turning point or the tail of its settling.
+  const double tolerance = options_.rest_load_tolerance / options_.rig.ps;
+  RestLoads loads;
+  for (std::size_t i = 0; i < scratch_.size();) {
     std::size_t j = i;
-    double load_sum = 0.0;
-    for (; j < learned_.size() && learned_[j].block == learned_[i].block; ++j) {
-      load_sum += learned_[j].load;
+    while (j < scratch_.size() && scratch_[j] - scratch_[i] <= tolerance) ++j;
+    if (j - i >= block_hops_) {
+      if (loads.distinct == 0) loads.low = scratch_[i];
+      loads.high = scratch_[j - 1];
+      ++loads.distinct;
     }
-    if (j - i >= min_rest_hops_) scratch_.push_back(load_sum / static_cast<double>(j - i));
     i = j;
   }
-  if (scratch_.empty()) return false;
-  std::sort(scratch_.begin(), scratch_.end());
-  // Distinct: further from the lowest load of the current group than the tolerance.
-  const double tolerance = options_.rest_load_tolerance / options_.rig.ps;
-  double group_start = scratch_.front();
-  std::size_t distinct = 1;
-  for (const double load : scratch_) {
-    if (load - group_start > tolerance) {
-      group_start = load;
-      ++distinct;
-    }
-  }
-  if (static_cast<double>(distinct) < options_.min_rest_loads) return false;
-  rest_load_low_ = scratch_.front();
-  rest_load_high_ = scratch_.back();
+  return loads;
+}
+
+bool FlowBalanceDetector::excited_enough() {
+  // The healthy command has an offset, a slope and a curvature on each side of zero load
+  // (healthy_terms), so a side is identified by rests at min_rest_loads distinct loads of its
+  // own: a hold at one load and the first two rests of the steps identify neither, and a fit
+  // to them judged the steps that followed by coefficients fitted to noise.
+  const double needed = options_.min_rest_loads;
+  const RestLoads positive = distinct_rest_loads(1.0);
+  const RestLoads negative = distinct_rest_loads(-1.0);
+  const bool use_positive = static_cast<double>(positive.distinct) >= needed;
+  const bool use_negative = static_cast<double>(negative.distinct) >= needed;
+  if (!use_positive && !use_negative) return false;
+  // A side seen at too few loads is left out of the fit and, by the learned range, not judged.
+  std::erase_if(learned_, [&](const RestHop& rest) {
+    return rest.load > 0.0 ? !use_positive : !use_negative;
+  });
+  rest_load_low_ = use_negative ? negative.low : positive.low;
+  rest_load_high_ = use_positive ? positive.high : negative.high;
   return true;
 }
 

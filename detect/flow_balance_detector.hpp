@@ -71,9 +71,10 @@ struct FlowBalanceOptions {
   double drift_window_seconds = 120.0;
   // Supply from the chamber pressures at rest when there is no `ps` observation.
   bool estimate_supply = true;
-  // Excitation (MODEL.md "Test programs"). The healthy command is fitted against the load, so
-  // learning needs blocks at rest at `min_rest_loads` loads |p1 - p2| further apart than
-  // `rest_load_tolerance` [Pa]: a hold gives one load, from which the fit extrapolates wildly.
+  // Excitation (MODEL.md "Test programs"). The healthy command is fitted against the load on
+  // each side of zero load, so learning needs blocks at rest at `min_rest_loads` loads p1 - p2
+  // further apart than `rest_load_tolerance` [Pa] on one side at least (a side with fewer is
+  // left out and not judged): a hold gives one load, from which the fit extrapolates wildly.
   // A learning period without them starts over, for at most `max_excitation_wait_seconds`
   // after the first; then the detector says it cannot learn rather than learn a wrong model.
   double min_rest_loads = 3.0;
@@ -162,8 +163,16 @@ class FlowBalanceDetector final : public Detector {
   void accept(const Hop& hop, bool at_rest);
   void finish_learning();
   // At the end of a learning period: whether its blocks at rest cover min_rest_loads distinct
-  // loads; sets rest_load_low_ / rest_load_high_ from them. Uses scratch_.
+  // loads on one side of zero load at least; drops the rest hops of a side that does not and
+  // sets rest_load_low_ / rest_load_high_ from the sides that do. Uses scratch_.
   bool excited_enough();
+  // The distinct loads the learning data rested at on one side (+1 or -1) of zero load, and the
+  // lowest and highest of them [of ps]. Uses scratch_.
+  struct RestLoads {
+    std::size_t distinct = 0;
+    double low = kMissing, high = kMissing;
+  };
+  RestLoads distinct_rest_loads(double side);
   // The decision's judged state at source time t.
   void set_judged(Decision& decision, double t) const;
   // The learned-change probe (learned_change.hpp) over the learning data, once it is complete.

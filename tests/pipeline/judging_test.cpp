@@ -86,5 +86,25 @@ TEST(Judging, ShorterSpellsThanTheEventTimeStayOutOfTheEventLog) {
   EXPECT_LT(status.not_judged_since, kSineStart + 20.0);
 }
 
+// A hold, a long sine and only then the steps (sim/scenarios/hold-sine-steps.yaml): the learning
+// period that ends 5.8 s into the steps holds a few rests only (a fit to them raised 4 false
+// alarms here). It is not learned from; the next period, all steps, is.
+TEST(Judging, AHoldAndASineThenStepsAreLearnedOnTheStepsAloneWithoutAFalseLeak) {
+  constexpr double kStepsBegin = 627.0, kPeriod = 92.8;
+  const capture::Capture capture =
+      sim::simulate(sim::load_scenario(test::source_dir() + "/sim/scenarios/hold-sine-steps.yaml"));
+  const ReplayResult result = replay_capture(capture, default_replay_config(capture));
+  for (const auto& e : of_kind(result.events, io::EventKind::alarm_raised)) {
+    ADD_FAILURE() << "false alarm " << e.alarm << " at t " << e.t;
+  }
+  const ActuatorStatus& status = result.actuators.front();
+  EXPECT_TRUE(status.judged);
+  EXPECT_EQ(status.not_judged_reason, detect::NotJudgedReason::none);
+  // Judged for about the steps' time after one whole period of them was learned from.
+  const double steps_seconds = status.decided_seconds - kStepsBegin;
+  EXPECT_GT(status.judged_seconds, 0.5 * (steps_seconds - 2 * kPeriod));
+  EXPECT_LT(status.judged_seconds, steps_seconds - kPeriod);
+}
+
 }  // namespace
 }  // namespace leakmon::pipeline
