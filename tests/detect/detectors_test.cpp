@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -298,6 +299,47 @@ TEST(FlowBalanceExcitation, WithoutTheLimitAFarHoldIsJudged) {
   hold_at(rig, 0.09, 60.0);
   while (rig.t < 259.0) d = detector.update(rig.next());
   EXPECT_TRUE(d.judged);
+}
+
+// The healthy command's offset, slope and curvature are fitted on each side of zero load. Steps
+// on the positive side and a single 10 s hold on the negative one while learning: the negative
+// side's terms rest on one load (a fit judged it by noise), so it is left out of the fit and not
+// judged, while the positive side is learned and judged.
+TEST(FlowBalanceExcitation, ASideRestedAtOneLoadIsNeitherLearnedNorJudged) {
+  auto detector = make_detector("flow_balance", kAll, 0.04, nullptr);
+  test::SyntheticRig rig;
+  std::mt19937_64 rng{7};
+  std::uniform_real_distribution<double> position(0.025, 0.05), hold_seconds(0.5, 4.0);
+  bool held_negative = false;
+  const auto step_positive_only = [&](double negative_hold_at) {
+    if (rig.hold_left > rig.hop) return;  // next() would otherwise draw a target on either side
+    if (!held_negative && rig.t > negative_hold_at) {
+      rig.target = -0.03;
+      rig.hold_left = 10.0 + rig.hop;
+      held_negative = true;
+    } else {
+      rig.target = position(rng);
+      rig.hold_left = hold_seconds(rng) + rig.hop;
+    }
+  };
+  Decision d;
+  while (rig.t < 150.0) {
+    step_positive_only(40.0);
+    d = detector->update(rig.next());
+  }
+  ASSERT_TRUE(held_negative);
+  ASSERT_FALSE(d.learning);
+  EXPECT_TRUE(d.judged);
+  hold_at(rig, -0.03, 30.0);  // the load the negative side rested at while learning
+  while (rig.t < 179.0) d = detector->update(rig.next());
+  EXPECT_FALSE(d.judged);
+  EXPECT_EQ(d.not_judged_reason, NotJudgedReason::outside_learned_loads);
+  while (rig.t < 220.0) {
+    step_positive_only(1e9);
+    d = detector->update(rig.next());
+  }
+  EXPECT_TRUE(d.judged);
+  EXPECT_LT(d.score, detector->raise_threshold());
 }
 
 // Pressure-only: an index far below its learned level (no hydraulic mode rung) is not judged.
