@@ -91,8 +91,12 @@ double ActuatorModel::spool_input(double u) const {
   return sim::spool_command(u + c_.u_bias, c_.u_max);
 }
 
-ActuatorState ActuatorModel::derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
-                                        double spool_in, double w, double t) const {
+// Always inlined into advance(), its one caller, four times per sub-step: GCC kept it out of
+// line, each call passing the state and its rates through memory (model_check_bench's
+// BM_FittingResiduals 3.3 -> 2.6 ms inlined, the same numbers).
+[[gnu::always_inline]] inline ActuatorState ActuatorModel::derivative(
+    const sim::ActuatorCoefficients& c, const ActuatorState& s, double spool_in, double w,
+    double t) const {
   const sim::ActuatorRates r = sim::actuator_rates(c, t, spool_in, w, parameters_.effects.C_L,
                                                    c.C_E, s.xs, s.x, s.v, s.p1, s.p2);
   ActuatorState d{r.xs, r.x, r.v, r.p1, r.p2, 0.0};
