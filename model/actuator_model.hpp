@@ -63,6 +63,9 @@ class ActuatorModel {
   double spool_input(double u) const;
 
  private:
+  // The largest eigenvalue magnitude substeps() resolves: fixed by the coefficients, so it is
+  // worked out once rather than on every sample interval of every segment.
+  double fastest_rate() const;
   ActuatorState derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
                            double spool_in, double w, double t) const;
 
@@ -70,6 +73,7 @@ class ActuatorModel {
   sim::Parameters rig_;
   sim::ActuatorCoefficients c_;
   bool lagging_ = false;
+  double fastest_rate_ = 0.0;
   sim::Oil oil_ = sim::Oil::standard();
 };
 

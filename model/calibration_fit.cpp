@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <unsupported/Eigen/LevenbergMarquardt>
@@ -60,7 +61,7 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   // Only the calibration parameters flagged in `free` are unknowns; the others stay at `start`.
   SegmentFitProblem(const SegmentPredictor& predictor, std::span<const Segment> segments,
                     const EffectCandidate* candidate, const Calibration& start,
-                    const CalibrationMask& free, const Calibration& stated)
+                    const CalibrationMask& free, const Calibration& stated, bool reuse_evaluations)
       : Eigen::DenseFunctor<double>(
             static_cast<int>(std::count(free.begin(), free.end(), true)) +
                 static_cast<int>(candidate ? candidate->parameters.size() : 0),
@@ -69,7 +70,8 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
         segments_(segments),
         candidate_(candidate),
         start_(start),
-        scales_(stated) {
+        scales_(stated),
+        reuse_evaluations_(reuse_evaluations) {
     for (int i = 0; i < kCalibrationCount; ++i) {
       if (free[static_cast<std::size_t>(i)]) calibration_slot_[i] = first_effect_++;
     }
@@ -110,11 +112,27 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
     return v;
   }
 
+  // The solver asks for the residuals at a point it has evaluated before: its Jacobian is
+  // taken where the last step was accepted (or at the start), and fit_model then reads the
+  // residuals and the Jacobian at the optimum. Those points are answered from the last few
+  // evaluations (bit-identical points, so the same residuals); each still counts as one.
   int operator()(const InputType& theta, ValueType& residuals) const {
     ++evaluations_;
-    predictor_.residuals(
-        model(theta), segments_,
-        std::span<double>(residuals.data(), static_cast<std::size_t>(residuals.size())));
+    if (reuse_evaluations_) {
+      for (const auto& kept : recent_) {
+        if (same_point(kept.theta, theta)) {
+          residuals = kept.residuals;
+          return 0;
+        }
+      }
+    }
+    simulate(theta, residuals);
+    if (reuse_evaluations_) {
+      // The accepted point and the rejected trials after it.
+      constexpr std::size_t kKept = 4;
+      if (recent_.size() >= kKept) recent_.erase(recent_.begin());
+      recent_.push_back({theta, residuals});
+    }
     return 0;
   }
 
@@ -128,7 +146,9 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
       InputType t = theta;
       const double h = 1e-5 * std::max(std::abs(theta[j]), 1.0);
       t[j] += h;
-      (*this)(t, shifted);
+      // A shifted point is not asked for again: not kept.
+      ++evaluations_;
+      simulate(t, shifted);
       jacobian.col(j) = (shifted - base) / h;
     }
     return 0;
@@ -138,6 +158,21 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   double scale(int i) const { return scales_[i]; }
 
  private:
+  void simulate(const InputType& theta, ValueType& residuals) const {
+    predictor_.residuals(
+        model(theta), segments_,
+        std::span<double>(residuals.data(), static_cast<std::size_t>(residuals.size())));
+  }
+  static bool same_point(const InputType& a, const InputType& b) {
+    return a.size() == b.size() &&
+           std::memcmp(a.data(), b.data(), static_cast<std::size_t>(a.size()) * sizeof(double)) ==
+               0;
+  }
+
+  struct Evaluation {
+    InputType theta;
+    ValueType residuals;
+  };
   const SegmentPredictor& predictor_;
   std::span<const Segment> segments_;
   const EffectCandidate* candidate_;
@@ -145,6 +180,8 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   Scales scales_;
   int calibration_slot_[kCalibrationCount] = {-1, -1, -1, -1};
   int first_effect_ = 0;
+  bool reuse_evaluations_ = true;
+  mutable std::vector<Evaluation> recent_;  // newest last
   mutable int evaluations_ = 0;
 };
 
@@ -224,7 +261,7 @@ FitResult fit_model(const SegmentPredictor& predictor, std::span<const Segment> 
                     const EffectCandidate* candidate, const Calibration& start,
                     const FitSettings& settings) {
   SegmentFitProblem problem(predictor, segments, candidate, start, settings.free_calibration,
-                            settings.stated);
+                            settings.stated, settings.reuse_evaluations);
   Eigen::VectorXd theta = problem.start_point();
   Eigen::LevenbergMarquardt<SegmentFitProblem> solver(problem);
   solver.setMaxfev(settings.max_iterations);

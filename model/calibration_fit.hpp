@@ -23,6 +23,9 @@ struct FitSettings {
   // The rig's stated beta, Kv, m, b: the solver's scales and the bounds (twice MODEL.md's
   // calibratable ranges) are relative to them. The paper's rig unless a rig is described.
   Calibration stated;
+  // Answer the solver's repeated requests for the same point from the evaluations kept (the
+  // same numbers, one simulation fewer per solver step); false simulates every request.
+  bool reuse_evaluations = true;
 };
 
 struct FitResult {

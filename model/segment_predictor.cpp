@@ -1,6 +1,7 @@
 #include "model/segment_predictor.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -102,6 +103,46 @@ std::vector<double> SegmentPredictor::spool_positions(const ActuatorModel& model
   return xs;
 }
 
+SegmentPredictor::SpoolLaw SegmentPredictor::spool_law(const ActuatorModel& model,
+                                                       const ActuatorModel* before,
+                                                       double onset_s) {
+  SpoolLaw law;
+  law.values = {model.spool_tau(), model.coefficients().u_bias, model.coefficients().u_max};
+  if (before) {
+    // A spool whose tau is zero does not exist, so the zeros left without an onset cannot
+    // stand for a model before one.
+    law.values[3] = before->spool_tau();
+    law.values[4] = before->coefficients().u_bias;
+    law.values[5] = before->coefficients().u_max;
+    law.values[6] = onset_s;
+  }
+  return law;
+}
+
+bool SegmentPredictor::SpoolLaw::same_as(const SpoolLaw& other) const {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (std::bit_cast<std::uint64_t>(values[i]) != std::bit_cast<std::uint64_t>(other.values[i]))
+      return false;
+  }
+  return true;
+}
+
+std::shared_ptr<const std::vector<double>> SegmentPredictor::shared_spool_positions(
+    const ActuatorModel& model, const ActuatorModel* before, double onset_s) const {
+  // A handful: a fit alternates between at most a few laws (a model before and after an
+  // onset, the floor's model between fits); more would only hold memory.
+  constexpr std::size_t kKept = 4;
+  const SpoolLaw law = spool_law(model, before, onset_s);
+  for (const auto& kept : spool_runs_) {
+    if (kept.law.same_as(law)) return kept.positions;
+  }
+  auto positions =
+      std::make_shared<const std::vector<double>>(spool_positions(model, before, onset_s));
+  if (spool_runs_.size() >= kKept) spool_runs_.erase(spool_runs_.begin());
+  spool_runs_.push_back({law, positions});
+  return positions;
+}
+
 template <typename Visit>
 void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Segment> segments,
                            Visit&& visit) const {
@@ -118,8 +159,9 @@ void SegmentPredictor::run(const ModelParameters& parameters, std::span<const Se
   const auto model_at = [&](double t) -> const ActuatorModel& {
     return switches && t < parameters.onset_s ? *before : after;
   };
-  const std::vector<double> xs =
-      spool_positions(after, switches ? &*before : nullptr, parameters.onset_s);
+  const auto spool =
+      shared_spool_positions(after, switches ? &*before : nullptr, parameters.onset_s);
+  const std::vector<double>& xs = *spool;
   // oil_temperature: the coefficients follow the measured oil temperature, sample by sample
   // (it changes over minutes; a missing reading holds the last one).
   const bool follows_temperature = parameters.effects.visc_slope > 0.0 && !record_.temp.empty();

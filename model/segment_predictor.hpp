@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -110,6 +111,13 @@ class SegmentPredictor {
   std::vector<double> spool_positions(const ActuatorModel& model,
                                       const ActuatorModel* before = nullptr,
                                       double onset_s = 0.0) const;
+  // The same, kept for the last few spool laws: the spool runs over the whole record (its
+  // state at a segment's start depends on all the commands before it), several times the
+  // segments' own length, while a fit of the calibration or of most effects leaves the spool
+  // law unchanged from one evaluation to the next.
+  std::shared_ptr<const std::vector<double>> shared_spool_positions(
+      const ActuatorModel& model, const ActuatorModel* before = nullptr,
+      double onset_s = 0.0) const;
   template <typename Visit>
   void run(const ModelParameters& parameters, std::span<const Segment> segments,
            Visit&& visit) const;
@@ -119,6 +127,20 @@ class SegmentPredictor {
   ChannelScales scales_;
   std::vector<double> velocity_;   // from a local least-squares line through x
   std::vector<double> dp1_, dp2_;  // central differences of the pressure readings
+  // Everything spool_positions reads from its models (the spool's tau, u0 and u_max, then the
+  // same before an onset and the onset's time; zeros without one): equal laws give equal
+  // positions. Compared bit for bit, so that a -0 bias is not taken for a +0 one.
+  struct SpoolLaw {
+    std::array<double, 7> values{};
+    bool same_as(const SpoolLaw& other) const;
+  };
+  static SpoolLaw spool_law(const ActuatorModel& model, const ActuatorModel* before,
+                            double onset_s);
+  struct SpoolRun {
+    SpoolLaw law;
+    std::shared_ptr<const std::vector<double>> positions;
+  };
+  mutable std::vector<SpoolRun> spool_runs_;  // newest last
 };
 
 }  // namespace leakmon::model

@@ -11,6 +11,7 @@
 #include "model/actuator_model.hpp"
 #include "model/calibration_fit.hpp"
 #include "model/diagnosis.hpp"
+#include "model/effect_library.hpp"
 #include "model/force_balance.hpp"
 #include "model/measured_record.hpp"
 #include "model/synthetic_case.hpp"
@@ -249,6 +250,78 @@ TEST(Calibration, ValueOnItsBoundHasTheProfilesErrorNotZero) {
               held.cost / inside.cost, ratio);
   EXPECT_GT(ratio, 1.0 / 3.0);
   EXPECT_LT(ratio, 3.0);
+}
+
+// fit_model answers the solver's repeated requests for a point (the Jacobian's base, the
+// optimum's residuals and Jacobian) from the evaluations it kept: the fit must be the one
+// that simulates every request, bit for bit, on the path with the most repeats (an effect
+// candidate, errors asked for, Kv held on its bound so that the profile's refits run too).
+TEST(Calibration, ReusedEvaluationsGiveTheFitOfFreshOnes) {
+  const auto seed = test::model_test_seed("Calibration.ReusedEvaluationsGiveTheFitOfFreshOnes");
+  const SyntheticCase c = draw_case(seed, "internal_leakage", {24.0});
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const SegmentPredictor predictor(record);
+  const auto segments = spread(split_record(record).fitting, 8);
+  const auto library = effect_library(0.0);
+  const auto leak = std::find_if(library.begin(), library.end(), [](const EffectCandidate& e) {
+    return e.effect == "internal_leakage";
+  });
+  ASSERT_NE(leak, library.end());
+  FitSettings settings;
+  settings.uncertainties = true;
+  settings.stated = Calibration::of(c.scenario.params);
+  settings.stated.Kv *= 1.3;
+  FitSettings fresh = settings;
+  fresh.reuse_evaluations = false;
+  const FitResult reused = fit_model(predictor, segments, &*leak, settings.stated, settings);
+  const FitResult simulated = fit_model(predictor, segments, &*leak, settings.stated, fresh);
+  const auto on_bound = calibration_at_bound(reused.parameters.calibration, settings.stated);
+  std::printf("  seed %llu: %zu values on their bounds, cost %.6g, %d evaluations\n",
+              static_cast<unsigned long long>(seed), on_bound.size(), reused.cost,
+              reused.evaluations);
+  EXPECT_FALSE(on_bound.empty()) << "no profile refits: only the solver's repeats are tested";
+  const auto same_calibration = [](const Calibration& a, const Calibration& b) {
+    EXPECT_EQ(a.beta, b.beta);
+    EXPECT_EQ(a.Kv, b.Kv);
+    EXPECT_EQ(a.m, b.m);
+    EXPECT_EQ(a.b, b.b);
+  };
+  same_calibration(reused.parameters.calibration, simulated.parameters.calibration);
+  same_calibration(reused.calibration_errors, simulated.calibration_errors);
+  EXPECT_EQ(reused.parameters.effects.C_L, simulated.parameters.effects.C_L);
+  EXPECT_EQ(reused.values, simulated.values);
+  EXPECT_EQ(reused.value_errors, simulated.value_errors);
+  EXPECT_EQ(reused.cost, simulated.cost);
+  EXPECT_EQ(reused.evaluations, simulated.evaluations);
+}
+
+// The predictor keeps the spool positions of its last few spool laws: residuals from a kept
+// run must be those of a predictor that has kept nothing, also after the laws kept have been
+// replaced (more laws than it keeps, in turn, twice) and with a law switching at an onset.
+TEST(SegmentPredictor, KeptSpoolPositionsGiveTheResidualsOfFreshOnes) {
+  const auto seed =
+      test::model_test_seed("SegmentPredictor.KeptSpoolPositionsGiveTheResidualsOfFreshOnes");
+  const SyntheticCase c = draw_case(seed, "spool_lag", {24.0});
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const auto segments = spread(split_record(record).fitting, 8);
+  std::vector<ModelParameters> laws(6);
+  laws[1].effects.spool_tau = 0.02;
+  laws[2].effects.u0 = 0.05;
+  laws[3].effects.u0 = -0.05;
+  laws[4].calibration.Kv *= 1.1;  // the same spool law as laws[0]: a kept run reused
+  laws[5].onset_s = 12.0;
+  laws[5].effects.spool_tau = 0.02;
+  const SegmentPredictor kept(record);
+  std::vector<double> from_kept(SegmentPredictor::residual_count(segments));
+  std::vector<double> from_fresh(from_kept.size());
+  for (int round = 0; round < 2; ++round) {
+    for (std::size_t i = 0; i < laws.size(); ++i) {
+      kept.residuals(laws[i], segments, from_kept);
+      const SegmentPredictor fresh(record);
+      fresh.residuals(laws[i], segments, from_fresh);
+      EXPECT_EQ(from_kept, from_fresh) << "round " << round << ", law " << i;
+    }
+  }
 }
 
 // The whole workflow on a short capture with a clear leak, cheap enough for the sanitizer
