@@ -310,8 +310,9 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
          drift_options<O>(1.0) + estimate_supply_options<O>() +
          std::vector<Option<O>>{
              number_option<O>("min_rest_loads", 1.0, 100.0,
-                              "learning needs blocks at rest at this many distinct loads on a side "
-                              "of zero load (a side with fewer is not judged)",
+                              "learning needs this many rests (a block long), counted on the sides "
+                              "of zero load whose rests lie further apart than rest_load_tolerance "
+                              "(a side without is not judged)",
                               [](O& o) -> double& { return o.min_rest_loads; }),
              number_option<O>("rest_load_tolerance", 1e3, 1e8,
                               "rest loads |p1 - p2| further apart than this are distinct [Pa]",

@@ -151,51 +151,69 @@ bool FlowBalanceDetector::on_flow_branch(const Hop& hop) const {
   return !(short_of_healthy > kOffBranchSigmas * hop_sigma_);
 }
 
-FlowBalanceDetector::RestLoads FlowBalanceDetector::distinct_rest_loads(double side) {
-  // Loads of the hops at rest on this side, in units of ps. Hops, not block means: a block
-  // that holds the end of one rest and the start of the next has a mean load between two rests
-  // that was never held.
-  scratch_.clear();
+FlowBalanceDetector::RestLoads FlowBalanceDetector::rests_on_side(double side) const {
+  // A rest: consecutive hops at rest (no hop missing between them) on this side, counted once
+  // it lasts a block (a few hops at rest are a move's turning point or the tail of its
+  // settling). Its load is its hops' mean: a block mean could span the end of one rest and the
+  // start of the next, a load between them that was never held.
+  RestLoads rests;
+  const auto close_rest = [&](double load_sum, std::size_t hops) {
+    if (hops < block_hops_) return;
+    const double load = load_sum / static_cast<double>(hops);
+    rests.low = rests.count == 0 ? load : std::min(rests.low, load);
+    rests.high = rests.count == 0 ? load : std::max(rests.high, load);
+    ++rests.count;
+  };
+  double load_sum = 0.0, previous_t = kMissing;
+  std::size_t hops = 0;
   for (const auto& rest : learned_) {
-    if (rest.load * side > 0.0) scratch_.push_back(rest.load);
-  }
-  std::sort(scratch_.begin(), scratch_.end());
-  // A group starts further from the lowest load of the current group than the tolerance, and
-  // counts once it holds a block's worth of hops at rest: a rest of a few hops is a move's
-  // turning point or the tail of its settling.
-  const double tolerance = options_.rest_load_tolerance / options_.rig.ps;
-  RestLoads loads;
-  for (std::size_t i = 0; i < scratch_.size();) {
-    std::size_t j = i;
-    while (j < scratch_.size() && scratch_[j] - scratch_[i] <= tolerance) ++j;
-    if (j - i >= block_hops_) {
-      if (loads.distinct == 0) loads.low = scratch_[i];
-      loads.high = scratch_[j - 1];
-      ++loads.distinct;
+    const bool continues = rest.t - previous_t < 1.5 * hop_seconds_;  // false after NaN
+    previous_t = rest.t;
+    if (!(rest.load * side > 0.0)) {
+      close_rest(load_sum, hops);
+      load_sum = 0.0, hops = 0;
+      continue;
     }
-    i = j;
+    if (!continues) {
+      close_rest(load_sum, hops);
+      load_sum = 0.0, hops = 0;
+    }
+    load_sum += rest.load;
+    ++hops;
   }
-  return loads;
+  close_rest(load_sum, hops);
+  return rests;
 }
 
-bool FlowBalanceDetector::excited_enough() {
+FlowBalanceDetector::LearnedSides FlowBalanceDetector::excited_enough() {
   // The healthy command has an offset, a slope and a curvature on each side of zero load
-  // (healthy_terms), so a side is identified by rests at min_rest_loads distinct loads of its
-  // own: a hold at one load and the first two rests of the steps identify neither, and a fit
-  // to them judged the steps that followed by coefficients fitted to noise.
+  // (healthy_terms), so each side needs rests of its own at loads further apart than
+  // rest_load_tolerance: two rests for its offset and slope, three for its curvature. A hold at
+  // one load and the first two rests of the steps identify neither side; a fit to them judged
+  // the steps that followed by coefficients fitted to noise.
   const double needed = options_.min_rest_loads;
-  const RestLoads positive = distinct_rest_loads(1.0);
-  const RestLoads negative = distinct_rest_loads(-1.0);
-  const bool use_positive = static_cast<double>(positive.distinct) >= needed;
-  const bool use_negative = static_cast<double>(negative.distinct) >= needed;
-  if (!use_positive && !use_negative) return false;
+  const double tolerance = options_.rest_load_tolerance / options_.rig.ps;
+  const RestLoads positive = rests_on_side(1.0);
+  const RestLoads negative = rests_on_side(-1.0);
+  const auto identified = [&](const RestLoads& rests) {
+    if (needed < 2.0) return static_cast<double>(rests.count) >= needed;
+    return rests.count >= 2 && rests.high - rests.low > tolerance;
+  };
+  LearnedSides sides;
+  sides.positive = identified(positive);
+  sides.negative = identified(negative);
+  const std::size_t count =
+      (sides.positive ? positive.count : 0) + (sides.negative ? negative.count : 0);
+  if (static_cast<double>(count) < needed || (!sides.positive && !sides.negative)) return {};
+  sides.positive_curved = sides.positive && positive.count >= 3;
+  sides.negative_curved = sides.negative && negative.count >= 3;
   // A side seen at too few loads is left out of the fit and, by the learned range, not judged.
   std::erase_if(learned_, [&](const RestHop& rest) {
-    return rest.load > 0.0 ? !use_positive : !use_negative;
+    return rest.load > 0.0 ? !sides.positive : !sides.negative;
   });
-  rest_load_low_ = use_negative ? negative.low : positive.low;
-  rest_load_high_ = use_positive ? positive.high : negative.high;
-  return true;
+  rest_load_low_ = sides.negative ? negative.low : positive.low;
+  rest_load_high_ = sides.positive ? positive.high : negative.high;
+  return sides;
 }
 
 void FlowBalanceDetector::set_judged(Decision& decision, double t) const {
@@ -214,9 +232,14 @@ void FlowBalanceDetector::set_judged(Decision& decision, double t) const {
   decision.not_judged_reason = decision.judged ? NotJudgedReason::none : block_reason_;
 }
 
-void FlowBalanceDetector::finish_learning() {
+void FlowBalanceDetector::finish_learning(const LearnedSides& sides) {
   positive_loads_ = learned_range(1.0);
   negative_loads_ = learned_range(-1.0);
+  // A side at two loads has no curvature to fit: a range of one point zeroes its term.
+  if (!sides.positive_curved)
+    positive_loads_ = {positive_loads_.middle, positive_loads_.middle, positive_loads_.middle};
+  if (!sides.negative_curved)
+    negative_loads_ = {negative_loads_.middle, negative_loads_.middle, negative_loads_.middle};
   // Two passes: the second fit leaves out the hops far off the first (both directions: all of
   // the learning data is healthy), so that a few dead-band crossings do not bend it.
   LeastSquares<kTerms> fit;
@@ -415,8 +438,8 @@ void FlowBalanceDetector::accept(const Hop& hop, bool at_rest) {
     if (clock_.period_over()) {
       const std::size_t max_wait_hops = static_cast<std::size_t>(
           std::lround(options_.max_excitation_wait_seconds / hop_seconds_));
-      if (excited_enough()) {
-        finish_learning();
+      if (const LearnedSides sides = excited_enough(); sides.positive || sides.negative) {
+        finish_learning(sides);
         block_reason_ = NotJudgedReason::in_motion;
       } else if (excitation_wait_hops_ >= max_wait_hops) {
         // Learning from these data would extrapolate the healthy command from one load.

@@ -72,9 +72,10 @@ struct FlowBalanceOptions {
   // Supply from the chamber pressures at rest when there is no `ps` observation.
   bool estimate_supply = true;
   // Excitation (MODEL.md "Test programs"). The healthy command is fitted against the load on
-  // each side of zero load, so learning needs blocks at rest at `min_rest_loads` loads p1 - p2
-  // further apart than `rest_load_tolerance` [Pa] on one side at least (a side with fewer is
-  // left out and not judged): a hold gives one load, from which the fit extrapolates wildly.
+  // each side of zero load, so learning needs `min_rest_loads` rests, counted on the sides whose
+  // rests lie at loads p1 - p2 further apart than `rest_load_tolerance` [Pa] (a side without is
+  // left out and not judged; one with fewer than three rests has no curvature term): a hold
+  // gives one load, from which the fit extrapolates wildly.
   // A learning period without them starts over, for at most `max_excitation_wait_seconds`
   // after the first; then the detector says it cannot learn rather than learn a wrong model.
   double min_rest_loads = 3.0;
@@ -161,18 +162,23 @@ class FlowBalanceDetector final : public Detector {
   static constexpr double kOffBranchSigmas = 6.0;
   static constexpr double kMinRoot = 1e-3;  // a chamber at supply or tank: no flow to judge
   void accept(const Hop& hop, bool at_rest);
-  void finish_learning();
-  // At the end of a learning period: whether its blocks at rest cover min_rest_loads distinct
-  // loads on one side of zero load at least; drops the rest hops of a side that does not and
-  // sets rest_load_low_ / rest_load_high_ from the sides that do. Uses scratch_.
-  bool excited_enough();
-  // The distinct loads the learning data rested at on one side (+1 or -1) of zero load, and the
-  // lowest and highest of them [of ps]. Uses scratch_.
+  // The sides of zero load the learning data identify (see excited_enough()).
+  struct LearnedSides {
+    bool positive = false, negative = false;                // offset and slope
+    bool positive_curved = false, negative_curved = false;  // and curvature
+  };
+  void finish_learning(const LearnedSides& sides);
+  // At the end of a learning period: the sides whose rests lie at loads further apart than
+  // rest_load_tolerance, if together they hold min_rest_loads rests, else none; drops the rest
+  // hops of a side left out and sets rest_load_low_ / rest_load_high_ from the sides kept.
+  LearnedSides excited_enough();
+  // The rests of the learning data on one side (+1 or -1) of zero load, and the lowest and
+  // highest of their loads [of ps].
   struct RestLoads {
-    std::size_t distinct = 0;
+    std::size_t count = 0;
     double low = kMissing, high = kMissing;
   };
-  RestLoads distinct_rest_loads(double side);
+  RestLoads rests_on_side(double side) const;
   // The decision's judged state at source time t.
   void set_judged(Decision& decision, double t) const;
   // The learned-change probe (learned_change.hpp) over the learning data, once it is complete.
