@@ -702,6 +702,56 @@ TEST(FlowLaw, LayoutThreeLoadsItsBlocksAsMoving) {
   }
 }
 
+// Layout 4 had no null-offset regressor. A state saved while learning keeps its blocks, which
+// lack the regressor, and learns without it as the build that wrote it (on a biased valve too);
+// one saved while judging decides as that build; one saved before its first learning block
+// learns the null offset.
+TEST(FlowLaw, LayoutFourLearnsWithoutTheNullOffsetOnlyWhenItHadLearningBlocks) {
+  sim::Scenario s = program(29, {phase(sim::PhaseKind::steps, 0.0)}, 140.0);
+  s.effects.valve_bias = sim::ValveBias{0.08};
+  s.effects.internal_leakage = sim::InternalLeakage{1e-12, 100.0, 0.0};
+  const capture::Capture capture = sim::simulate(s);
+  FlowLawOptions options;
+  options.learning.learn_seconds = 40.0;
+  FlowLawOptions layout_four = options;
+  layout_four.learn_null_offset = false;
+  for (const double cut_seconds : {0.5, 30.0, 80.0}) {  // settling, learning, judging
+    FlowLawDetector writer = make(layout_four);
+    const std::size_t split = static_cast<std::size_t>(cut_seconds * 500.0) + 3 * kStep;
+    run(writer, capture, 1e9, 0, split);
+    const DetectorState current = writer.export_state();
+    DetectorState saved("flow_law", 4);
+    for (const auto& [key, values] : current.entries()) {
+      if (!added_in_layout_five(key)) saved.put(key, values);
+    }
+    FlowLawDetector updated = make(options);
+    updated.import_state(saved);
+    const DetectorState converted = updated.export_state();
+    const auto& offsets = converted.get_list("learned.null_offset");
+    EXPECT_EQ(offsets.size(), current.get_list("learned.t").size());
+    EXPECT_TRUE(std::all_of(offsets.begin(), offsets.end(), [](double v) { return v == 0.0; }));
+    const Outcome a = run(writer, capture, 100.0, split);
+    const Outcome b = run(updated, capture, 100.0, split);
+    EXPECT_GT(b.first_raise, 100.0);
+    EXPECT_LT(b.max_score, updated.raise_threshold());
+    if (cut_seconds < 1.0) {
+      EXPECT_TRUE(offsets.empty());
+      EXPECT_EQ(converted.get("null_offset.fit"), 1.0);
+      // At one temperature the offset's flow is nearly a mix of the load term and the offset's
+      // (-0.0045 here for -0.008): fitted, with the offset's sign.
+      EXPECT_LT(updated.coefficients()[5], -0.002);
+      EXPECT_EQ(writer.coefficients()[5], 0.0);
+    } else {
+      EXPECT_EQ(converted.get("null_offset.fit"), cut_seconds < 40.0 ? 0.0 : 1.0);
+      EXPECT_EQ(updated.coefficients()[5], 0.0);
+      EXPECT_EQ(a.learned_at, b.learned_at);
+      EXPECT_EQ(a.first_raise, b.first_raise);
+      EXPECT_EQ(a.last.score, b.last.score);
+      EXPECT_EQ(a.last.leak_coefficient, b.last.leak_coefficient);
+    }
+  }
+}
+
 // Learning (and waiting for excitation), detection and the alarm allocate nothing; reset()
 // starts learning again.
 TEST(FlowLaw, UpdateAllocatesNothingAndResetStartsLearningAgain) {
