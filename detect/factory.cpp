@@ -393,6 +393,16 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                  },
                  0.0, 0.0,
                  [](O& o) { return std::string(o.learn_spool_time_constant ? "true" : "false"); }),
+             other_option<O>(
+                 "learn_null_offset", "", "true, false",
+                 "learn the valve's null-offset flow (a bias the command u does not show)",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr) {
+                     o.learn_null_offset = node->get_bool(row.key, o.learn_null_offset);
+                   }
+                 },
+                 0.0, 0.0,
+                 [](O& o) { return std::string(o.learn_null_offset ? "true" : "false"); }),
              number_option<O>("min_load_spread", 0.0, 1e9,
                               "learning waits until the learning blocks' mean loads p1 - p2 "
                               "spread this much (std) [Pa]",

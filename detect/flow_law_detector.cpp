@@ -38,6 +38,16 @@ double slope_of(double leak, const sim::Parameters& rig) {
   return leak * rig.ps / (rig.Kv * std::sqrt(rig.ps));
 }
 
+// d qL / d o at the opening o (MODEL.md "valve"; no null leakage), in units of Kv sqrt(ps): the
+// flow a small constant offset of the opening adds. qL is linear in o on each side of null, so
+// the slope is the flow of a unit opening on the opening's side.
+double null_offset_gain(double opening, double ps, double p1, double p2,
+                        const sim::Parameters& rig) {
+  const double side = opening >= 0.0 ? 1.0 : -1.0;
+  const sim::ValveFlows f = sim::valve_flows(side, ps, rig.pt, p1, p2, 1.0, rig.dp_lin, 0.0);
+  return side * 0.5 * (f.q1 - f.q2) / std::sqrt(rig.ps);
+}
+
 }  // namespace
 
 FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_seconds)
@@ -61,6 +71,7 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
     taus_[i] = options.rig.tau * std::exp2(third_octaves / 3.0);
   }
   reset_spool_time_constant();
+  fit_null_offset_ = options.learn_null_offset;
   learned_.reserve(learn_capacity_);
   probe_blocks_.reserve(learn_capacity_);
   rest_loads_.reserve(learn_capacity_);
@@ -80,6 +91,7 @@ void FlowLawDetector::reset() {
   excitation_ = Excitation{};
   no_load_blocks_ = 0;
   reset_spool_time_constant();
+  fit_null_offset_ = options_.learn_null_offset;
   supply_ = viscosity_ratio_ = kMissing;
   hop_usable_ = false;
   previous_x_ = kMissing;
@@ -114,6 +126,7 @@ void FlowLawDetector::restart_block() {
   block_hop_ = 0;
   block_ok_ = false;
   sum_flows_.fill(0.0);
+  sum_gain_ = 0.0;
   sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
   block_max_speed_ = 0.0;
@@ -144,6 +157,11 @@ void FlowLawDetector::add_sample(double u, double x, double p1, double p2) {
     if (have_previous_) sum_flows_[i] += 0.5 * dt * (flow + previous_flows_[i]);
     previous_flows_[i] = flow;
   }
+  // At the opening the flow is integrated with (the stated one while the ladder is weighed).
+  const double gain = null_offset_gain(
+      openings_[tau_index_ == kTauNotChosen ? kStatedTau : tau_index_], supply_, p1, p2, rig);
+  if (have_previous_) sum_gain_ += 0.5 * dt * (gain + previous_gain_);
+  previous_gain_ = gain;
   previous_command_ = command;
   const double load = p1 - p2;
   if (have_previous_) {
@@ -229,6 +247,7 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
     b.length = block_length_;
     b.mean_load = sum_load_ / block_length_;
     b.moving = block_max_speed_ < options_.rest_speed ? 0.0 : 1.0;
+    b.null_offset = sum_gain_;
   }
   block_hop_ = 0;
   block_ok_ = have_previous_ && hop_usable_;
@@ -236,6 +255,7 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
   start_p1_ = last_p1_;
   start_p2_ = last_p2_;
   sum_flows_.fill(0.0);
+  sum_gain_ = 0.0;
   sum_load_ = block_length_ = ratio_sum_ = 0.0;
   ratio_hops_ = 0;
   block_max_speed_ = 0.0;
@@ -254,6 +274,7 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
 void FlowLawDetector::learn(const Block& b) {
   if (learned_.size() == learn_capacity_) learned_.erase(learned_.begin());
   learned_.push_back(b);
+  if (!fit_null_offset_) learned_.back().null_offset = 0.0;  // a zero column: coefficient 0
   if (!clock_.period_over()) return;
   waiting_ = !identified();
   if (!waiting_) finish_learning();
@@ -396,12 +417,14 @@ void FlowLawDetector::choose_spool_time_constant() {
     double best = kMissing;
     tau_index_ = kStatedTau;
     for (std::size_t i = 0; i < kTauCandidates; ++i) {
-      LeastSquares<4> fit;
+      LeastSquares<5> fit;
       const auto without_lag = [](const Block& b) {
-        return Eigen::Vector4d(b.move, b.load, b.comp, b.length);
+        Eigen::Matrix<double, 5, 1> r;
+        r << b.move, b.load, b.comp, b.length, b.null_offset;
+        return r;
       };
       for (const auto& b : learned_) fit.add(without_lag(b), b.y_tau[i]);
-      const Eigen::Vector4d c = fit.solve();
+      const Eigen::Matrix<double, 5, 1> c = fit.solve();
       double sum_sq = 0.0;
       for (const auto& b : learned_) {
         const double r = b.y_tau[i] - c.dot(without_lag(b));
@@ -548,8 +571,8 @@ Decision FlowLawDetector::decide() const {
 }
 
 namespace {
-constexpr std::array<std::string_view, 5> kCoefficientNames = {"move", "load", "comp", "length",
-                                                               "lag"};
+constexpr std::array<std::string_view, 6> kCoefficientNames = {"move",   "load", "comp",
+                                                               "length", "lag",  "null_offset"};
 
 template <std::size_t N>
 void ladder(const DetectorState& state, std::string_view key, std::array<double, N>& values) {
@@ -569,6 +592,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("learned.y_tau", y_tau);
   state.put("tau.index", tau_index_ == kTauNotChosen ? kMissing : static_cast<double>(tau_index_));
   state.put("tau.fit_lag", fit_lag_ ? 1.0 : 0.0);
+  state.put("null_offset.fit", fit_null_offset_ ? 1.0 : 0.0);
   for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
     state.put(state_key("coefficient", kCoefficientNames[i]),
               coefficients_[static_cast<Eigen::Index>(i)]);
@@ -586,6 +610,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("spool.previous_command", previous_command_);
   state.put("sample.have_previous", have_previous_ ? 1.0 : 0.0);
   state.put("sample.flows", previous_flows_);
+  state.put("sample.null_offset_gain", previous_gain_);
   state.put("sample.load", previous_load_);
   state.put("sample.x", last_x_);
   state.put("sample.p1", last_p1_);
@@ -596,6 +621,7 @@ DetectorState FlowLawDetector::export_state() const {
   state.put("block.start_p1", start_p1_);
   state.put("block.start_p2", start_p2_);
   state.put("block.flows", sum_flows_);
+  state.put("block.null_offset", sum_gain_);
   state.put("block.load", sum_load_);
   state.put("block.length", block_length_);
   state.put("block.ratio_sum", ratio_sum_);
@@ -640,6 +666,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
       throw StateError("'tau.index' out of range");
     }
     fit_lag_ = state.get("tau.fit_lag") != 0.0;
+    fit_null_offset_ = options_.learn_null_offset && state.get("null_offset.fit") != 0.0;
     for (std::size_t i = 0; i < kCoefficientNames.size(); ++i) {
       coefficients_[static_cast<Eigen::Index>(i)] =
           state.get(state_key("coefficient", kCoefficientNames[i]));
@@ -657,6 +684,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     previous_command_ = state.get("spool.previous_command");
     have_previous_ = state.get("sample.have_previous") != 0.0;
     ladder(state, "sample.flows", previous_flows_);
+    previous_gain_ = state.get("sample.null_offset_gain");
     previous_load_ = state.get("sample.load");
     last_x_ = state.get("sample.x");
     last_p1_ = state.get("sample.p1");
@@ -668,6 +696,7 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
     start_p1_ = state.get("block.start_p1");
     start_p2_ = state.get("block.start_p2");
     ladder(state, "block.flows", sum_flows_);
+    sum_gain_ = state.get("block.null_offset");
     sum_load_ = state.get("block.load");
     block_length_ = state.get("block.length");
     ratio_sum_ = state.get("block.ratio_sum");

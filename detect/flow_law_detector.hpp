@@ -20,6 +20,12 @@
 // with the step: the pattern of a leak. While learning, the flow is integrated for a ladder of
 // time constants around the stated one; learning keeps the rung whose fit leaves the least, and a
 // fifth regressor, the flow's slope between the neighbouring rungs, takes up the rest.
+// A valve's null offset (MODEL.md `valve_bias`: the valve sees u + u0, the capture records u) adds
+// the turbulent flow of a constant opening offset b, Kv b d qL / d o, which follows the pressures'
+// square roots and not the oil's viscosity. Fitted by no other regressor, it was learned cold by
+// the viscosity-scaled load term and the offset and over-predicted as the oil warmed (a morning
+// start raised some 50 times; docs/detection.md). The sixth regressor is that flow per unit
+// opening, d qL / d o at the block's openings integrated over the block; its coefficient is -b.
 #pragma once
 
 #include <array>
@@ -78,6 +84,8 @@ struct FlowLawOptions {
   // Learn the spool's time constant from the learning blocks (a ladder of kTauCandidates values,
   // a third of an octave apart around rig.tau); false keeps rig.tau.
   bool learn_spool_time_constant = true;
+  // Fit the valve's null-offset flow (the sixth regressor); false: the model before it.
+  bool learn_null_offset = true;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -102,9 +110,10 @@ class FlowLawDetector final : public Detector {
   // The learning period is over but the blocks seen so far do not identify the model (a hold
   // alone, a hold and a few seconds of motion, a single sine): waiting for excitation.
   bool waiting_for_excitation() const { return waiting_; }
-  static constexpr int kRegressors = 5;
+  static constexpr int kRegressors = 6;
   using Coefficients = Eigen::Matrix<double, kRegressors, 1>;
-  // The learned coefficients [a, c, k, d, lag] in normalised units (a = Kv_nominal / Kv_true).
+  // The learned coefficients [a, c, k, d, lag, null offset] in normalised units (a = Kv_nominal /
+  // Kv_true).
   Coefficients coefficients() const { return coefficients_; }
   std::size_t blocks_not_judged_no_load() const { return no_load_blocks_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
@@ -116,7 +125,9 @@ class FlowLawDetector final : public Detector {
   // (layout 2 loads as long at rest and with an empty run).
   // Layout 4 marks the learning blocks at rest and the block in progress's fastest hop (layout 3's
   // blocks load as moving, its block in progress as moving).
-  static constexpr int kStateVersion = 4;
+  // Layout 5 adds the null-offset regressor (layout 4's learning blocks load without it, and
+  // learning then fits without it as the build that wrote them would; its coefficient is 0).
+  static constexpr int kStateVersion = 5;
   // Motion alone identifies the load term only when at least this share of the learning blocks
   // move: a long hold with a few seconds of a sweep has a sharp but biased load term.
   static constexpr double kMotionBlockShare = 0.75;
@@ -149,9 +160,10 @@ class FlowLawDetector final : public Detector {
     double mean_load = kMissing;  // mean p1 - p2 [Pa]
     double lag = kMissing;        // d int qL dt per rung of the time-constant ladder
     double moving = 1.0;          // 0: every hop of the block slower than rest_speed
+    double null_offset = 0.0;     // int d qL / d o dt, the flow per unit opening offset
     std::array<double, kTauCandidates> y_tau{};  // int qL dt per rung (read while learning)
   };
-  static constexpr std::array<RecordField<Block>, 9> block_fields() {
+  static constexpr std::array<RecordField<Block>, 10> block_fields() {
     return {record_field<&Block::t>("t"),
             record_field<&Block::y>("y"),
             record_field<&Block::move>("move"),
@@ -160,10 +172,13 @@ class FlowLawDetector final : public Detector {
             record_field<&Block::length>("length"),
             record_field<&Block::mean_load>("mean_load"),
             record_field<&Block::lag>("lag"),
-            record_field<&Block::moving>("moving")};
+            record_field<&Block::moving>("moving"),
+            record_field<&Block::null_offset>("null_offset")};
   }
   static Coefficients regressors(const Block& b) {
-    return Coefficients(b.move, b.load, b.comp, b.length, b.lag);
+    Coefficients r;
+    r << b.move, b.load, b.comp, b.length, b.lag, b.null_offset;
+    return r;
   }
   double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
 
@@ -221,6 +236,9 @@ class FlowLawDetector final : public Detector {
   std::array<double, kTauCandidates> taus_{};
   std::size_t tau_index_ = kTauNotChosen;
   bool fit_lag_ = true;  // false: the chosen rung's flow alone (not learned, or an old layout)
+  // false: learning blocks from a layout without the null-offset regressor are among those
+  // learned on; the fit leaves it out (coefficient 0) until the next reset.
+  bool fit_null_offset_ = true;
   // Per sample and candidate: the spool (exact zero-order-hold lag) and the previous flow.
   std::array<double, kTauCandidates> openings_{};
   std::array<double, kTauCandidates> previous_flows_{};
@@ -233,6 +251,7 @@ class FlowLawDetector final : public Detector {
   bool block_ok_ = false;
   double start_x_ = 0.0, start_p1_ = 0.0, start_p2_ = 0.0;
   std::array<double, kTauCandidates> sum_flows_{};
+  double previous_gain_ = 0.0, sum_gain_ = 0.0;  // d qL / d o per sample, and its integral
   double sum_load_ = 0.0, block_length_ = 0.0, ratio_sum_ = 0.0;
   std::size_t ratio_hops_ = 0;
   double block_max_speed_ = 0.0;  // the block's fastest hop [m/s] (NaN: unknown, moving)

@@ -191,6 +191,25 @@ DetectorState flow_law_from_3(const DetectorState& old) {
   return out;
 }
 
+// flow_law 4 had no null-offset regressor (the valve's bias). A state that had learned judges as
+// it did (coefficient 0). A state still learning keeps its blocks without the regressor and learns
+// without it, as the build that wrote it would (`null_offset.fit` 0, until the next reset); one
+// with no learning block yet fits it, and its block in progress, whose integral of the
+// regressor is missing, is not used.
+DetectorState flow_law_from_4(const DetectorState& old) {
+  DetectorState out(old.kind(), 5);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  const std::size_t blocks = old.get_list("learned.t").size();
+  const bool learned = old.get("learning.learned") != 0.0;
+  out.put("learned.null_offset", std::vector<double>(blocks, 0.0));
+  out.put("coefficient.null_offset", 0.0);
+  out.put("null_offset.fit", blocks > 0 && !learned ? 0.0 : 1.0);
+  out.put("sample.null_offset_gain", 0.0);
+  out.put("block.null_offset", 0.0);
+  if (!learned && blocks == 0) out.put("block.ok", 0.0);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -425,6 +444,9 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() < 5 && version == 5) {
+      return flow_law_from_4(upgraded_state(state, kind, 4));
+    }
     if (kind == "flow_law" && state.version() < 4 && version == 4) {
       return flow_law_from_3(upgraded_state(state, kind, 3));
     }
