@@ -45,18 +45,19 @@ std::string alarm_state(int port) {
 TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
   const std::string dir = test::scratch_dir("http_process");
   const int port = test::free_port();
-  // A simulated rig whose leak opens at 7 s, after 1 s settling and 5 s learning; the alarm
-  // latches so that it waits for an acknowledgement.
+  // A simulated rig whose leak opens at 22 s, after 1 s settling and 20 s learning (the flow
+  // balance learns from rests on both sides of zero load: a few seconds of steps hold too few);
+  // the alarm latches so that it waits for an acknowledgement.
   std::ofstream(dir + "/leakmon.yaml")
       << "drivers:\n"
          "  - {name: rig, type: sim, scenario: healthy, seed: 7,\n"
-         "     leak: {lpm_per_mpa: 0.5, onset_s: 7, ramp_s: 0.5}}\n"
+         "     leak: {lpm_per_mpa: 0.5, onset_s: 22, ramp_s: 0.5}}\n"
          "sampling:\n"
          "  - {name: main, period_ms: 2, drivers: [rig], priority: 0}\n"
          "actuators:\n"
          "  - name: cylinder\n"
          "    channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x, xref: rig.xref}\n"
-         "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 5}}\n"
+         "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 20}}\n"
          "    alarm: {on_delay_s: 0.2, latching: true}\n"
          "events: {log: events.jsonl}\n"
          "metrics: {port: "
@@ -111,7 +112,7 @@ TEST(HttpProcess, LimitsMethodsAndStrictAcknowledgement) {
             std::string::npos);
 
   // Wait for the latched leak alarm, then try every typo: each a 4xx, none acknowledges.
-  ASSERT_TRUE(test::eventually([&] { return alarm_state(port) == "active_unacknowledged"; }, 40s))
+  ASSERT_TRUE(test::eventually([&] { return alarm_state(port) == "active_unacknowledged"; }, 60s))
       << alarm_state(port) << "\n"
       << daemon.log();
   const std::pair<const char*, int> typos[] = {{"/ack?foo=bar", 400},

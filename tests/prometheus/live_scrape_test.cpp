@@ -55,7 +55,7 @@ std::string config_text(int port, int save_seconds = 1) {
          "    type: sim\n"
          "    scenario: healthy\n"
          "    seed: 7\n"
-         "    leak: {lpm_per_mpa: 0.15, onset_s: 4, ramp_s: 0.5}\n"
+         "    leak: {lpm_per_mpa: 0.15, onset_s: 22, ramp_s: 0.5}\n"
          "    channels: [xref, u, x, p1, p2, temp]\n"
          "sampling:\n"
          "  - {name: main, period_ms: 2, drivers: [rig]}\n"
@@ -63,7 +63,7 @@ std::string config_text(int port, int save_seconds = 1) {
          "  - name: cylinder\n"
          "    channels: {p1: rig.p1, p2: rig.p2, u: rig.u, x: rig.x, xref: rig.xref, "
          "temp: rig.temp}\n"
-         "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 2}}\n"
+         "    detector: {kind: default, options: {settle_seconds: 1, learn_seconds: 20}}\n"
          "    alarm: {on_delay_s: 0.5, off_delay_s: 10, latching: false}\n"
          "events: {log: events.jsonl}\n"
          "metrics: {port: " +
@@ -77,7 +77,7 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
   const std::string dir = test::scratch_dir("prometheus_live_scrape");
   const int port = test::free_port();
   write(dir + "/leakmon.yaml", config_text(port));
-  test::DaemonProcess daemon({"run", "--config", dir + "/leakmon.yaml", "--duration", "40"},
+  test::DaemonProcess daemon({"run", "--config", dir + "/leakmon.yaml", "--duration", "70"},
                              dir + "/daemon.log");
 
   const std::string alarm =
@@ -95,7 +95,7 @@ TEST(PrometheusLiveScrape, GaugesPromtoolLintAndDashboardNamesHold) {
                std::isfinite(sample_value(
                    scrape, "leakmon_learned_state_age_seconds{actuator=\"cylinder\"}"));
       },
-      30s);
+      60s);
   ASSERT_TRUE(alarmed) << scrape << daemon.log();
 
   // The gauges with what the simulated rig has: the leak that opened, 40 degC oil, a state
