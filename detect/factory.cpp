@@ -437,6 +437,11 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               "leak at 40 degC that is never an alarm [m^3/(s Pa)]; the default "
                               "scales like design_leak's",
                               [](O& o) -> double& { return o.min_leak; }),
+             number_option<O>("max_leverage_ratio", 0.0, 1e6,
+                              "a block whose leverage on the learned fit exceeds this many times "
+                              "the largest learning block's is not judged (outside the learned "
+                              "range); 0: every block is judged",
+                              [](O& o) -> double& { return o.max_leverage_ratio; }),
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
                               [](O& o) -> double& { return o.rest_speed; }),

@@ -90,6 +90,9 @@ void FlowLawDetector::reset() {
   waiting_ = false;
   excitation_ = Excitation{};
   no_load_blocks_ = 0;
+  inverse_normal_.setZero();
+  max_learned_leverage_ = kMissing;
+  outside_range_blocks_ = 0;
   reset_spool_time_constant();
   fit_null_offset_ = options_.learn_null_offset;
   supply_ = viscosity_ratio_ = kMissing;
@@ -448,6 +451,12 @@ void FlowLawDetector::finish_learning() {
   LeastSquares<kRegressors> fit;
   for (const auto& b : learned_) fit.add(regressors(b), b.y);
   coefficients_ = fit.solve();
+  inverse_normal_ = fit.inverse_normal();
+  max_learned_leverage_ = 0.0;
+  for (const auto& b : learned_) {
+    const Coefficients x = regressors(b);
+    max_learned_leverage_ = std::max(max_learned_leverage_, x.dot(inverse_normal_ * x));
+  }
   double sum_sq = 0.0, sum_lag = 0.0, previous = 0.0;
   double previous_t = kMissing;
   for (const auto& b : learned_) {
@@ -475,6 +484,11 @@ void FlowLawDetector::judge(const Block& b) {
   if (std::abs(b.mean_load) < options_.min_load) {
     ++no_load_blocks_;
     block_reason_ = NotJudgedReason::no_load;
+    return;
+  }
+  if (outside_learned_range(b)) {
+    ++outside_range_blocks_;
+    block_reason_ = NotJudgedReason::outside_learned_regime;
     return;
   }
   last_judged_t_ = b.t;
@@ -508,6 +522,21 @@ void FlowLawDetector::judge(const Block& b) {
     run_.push({rl, ll});
     estimate_change_point();
   }
+}
+
+// Run 7 of `evaluate --conditions programs --seed 2531` learned on a 6 s triangle (its ladder
+// chose 3.2 ms for the valve's 2.5 ms: a triangle opens the valve slowly and barely shows the
+// lag) and then raised 273 s into a 0.5-2.5 Hz sweep: there the lag's term is tens of times the
+// triangle's, the blocks' leverage on the learned fit reached 1-4 against 0.2 for the largest
+// learning block, and the residual followed the load's sign by 5 spreads. A model judges only
+// the regressors it was learned on (docs/detection.md).
+bool FlowLawDetector::outside_learned_range(const Block& b) const {
+  if (!(options_.max_leverage_ratio > 0.0) || !(max_learned_leverage_ > 0.0)) return false;
+  Coefficients x = regressors(b);
+  // A regressor left out of the fit was a zero column while learning (its coefficient 0): the
+  // range has no extent along it and it does not count.
+  if (!fit_null_offset_) x[5] = 0.0;
+  return x.dot(inverse_normal_ * x) > options_.max_leverage_ratio * max_learned_leverage_;
 }
 
 // The CUSUM leaves zero on the noise of healthy blocks too, so its run holds blocks from before
@@ -598,6 +627,11 @@ DetectorState FlowLawDetector::export_state() const {
               coefficients_[static_cast<Eigen::Index>(i)]);
   }
   state.put("block_sigma", block_sigma_);
+  state.put(
+      "range.inverse_normal",
+      std::vector<double>(inverse_normal_.data(), inverse_normal_.data() + inverse_normal_.size()));
+  state.put("range.max_leverage", max_learned_leverage_);
+  state.put_count("range.outside_blocks", outside_range_blocks_);
   state.put("waiting", waiting_ ? 1.0 : 0.0);
   state.put_count("no_load_blocks", no_load_blocks_);
   state.put("supply", supply_);
@@ -672,6 +706,13 @@ void FlowLawDetector::import_state(const DetectorState& saved) {
           state.get(state_key("coefficient", kCoefficientNames[i]));
     }
     block_sigma_ = state.get("block_sigma");
+    const auto& inverse_normal = state.get_list("range.inverse_normal");
+    if (inverse_normal.size() != static_cast<std::size_t>(inverse_normal_.size())) {
+      throw StateError("'range.inverse_normal' has the wrong length");
+    }
+    std::copy(inverse_normal.begin(), inverse_normal.end(), inverse_normal_.data());
+    max_learned_leverage_ = state.get("range.max_leverage");
+    outside_range_blocks_ = state.get_count("range.outside_blocks");
     waiting_ = state.get("waiting") != 0.0;
     no_load_blocks_ = state.get_count("no_load_blocks");
     supply_ = state.get("supply");

@@ -86,6 +86,12 @@ struct FlowLawOptions {
   bool learn_spool_time_constant = true;
   // Fit the valve's null-offset flow (the sixth regressor); false: the model before it.
   bool learn_null_offset = true;
+  // A block whose leverage on the learned fit (x' (X'X)^-1 x over the learning blocks' regressors)
+  // exceeds this many times the largest learning block's is not judged: its flows lie beyond
+  // those the coefficients were learned on (a fast sweep judged by a model learned on a slow
+  // triangle extrapolates the spool lag's term); the status says `outside_learned_regime`.
+  // 0: every block is judged (the build before).
+  double max_leverage_ratio = 2.0;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -116,6 +122,10 @@ class FlowLawDetector final : public Detector {
   // Kv_true).
   Coefficients coefficients() const { return coefficients_; }
   std::size_t blocks_not_judged_no_load() const { return no_load_blocks_; }
+  std::size_t blocks_not_judged_outside_learned_range() const { return outside_range_blocks_; }
+  // The largest leverage among the learning blocks (NaN before learning, or from a layout-5
+  // state, which judges every block as its build did).
+  double max_learned_leverage() const { return max_learned_leverage_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
@@ -127,7 +137,9 @@ class FlowLawDetector final : public Detector {
   // blocks load as moving, its block in progress as moving).
   // Layout 5 adds the null-offset regressor (layout 4's learning blocks load without it, and
   // learning then fits without it as the build that wrote them would; its coefficient is 0).
-  static constexpr int kStateVersion = 5;
+  // Layout 6 adds the learned range: (X'X)^-1 and the largest learning leverage (layout 5 loads
+  // without them and judges every block, as its build did).
+  static constexpr int kStateVersion = 6;
   // Motion alone identifies the load term only when at least this share of the learning blocks
   // move: a long hold with a few seconds of a sweep has a sharp but biased load term.
   static constexpr double kMotionBlockShare = 0.75;
@@ -217,6 +229,12 @@ class FlowLawDetector final : public Detector {
   std::size_t learn_capacity_;
   Coefficients coefficients_ = Coefficients::Zero();
   double block_sigma_ = kMissing;
+  // The learned range: (X'X)^-1 of the learning blocks and their largest leverage (NaN: unknown).
+  Eigen::Matrix<double, kRegressors, kRegressors> inverse_normal_ =
+      Eigen::Matrix<double, kRegressors, kRegressors>::Zero();
+  double max_learned_leverage_ = kMissing;
+  std::size_t outside_range_blocks_ = 0;
+  bool outside_learned_range(const Block& b) const;
   bool waiting_ = false;
   Excitation excitation_;
   std::vector<double> rest_loads_;  // scratch, reserved as learned_

@@ -28,6 +28,15 @@ class LeastSquares {
     return a.ldlt().solve(xty_);
   }
 
+  // (X'X)^-1 with solve()'s ridge: a block's leverage x' (X'X)^-1 x is how far its regressors lie
+  // from those the coefficients were fitted on (1 at most for the blocks fitted).
+  Eigen::Matrix<double, N, N> inverse_normal() const {
+    Eigen::Matrix<double, N, N> a = xtx_;
+    const double ridge = 1e-9 * (a.trace() / N + 1e-300);
+    a.diagonal().array() += ridge;
+    return a.ldlt().solve(Eigen::Matrix<double, N, N>::Identity());
+  }
+
   // Residual variance of the fitted model (unbiased).
   double residual_variance(const Vector& beta) const {
     if (count_ <= static_cast<std::size_t>(N)) return 0.0;

@@ -210,6 +210,17 @@ DetectorState flow_law_from_4(const DetectorState& old) {
   return out;
 }
 
+// flow_law 5 kept no learned range: it loads without one and judges every block, as its build
+// did (a state learned again after a reset keeps the range).
+DetectorState flow_law_from_5(const DetectorState& old) {
+  DetectorState out(old.kind(), 6);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  out.put("range.inverse_normal", std::vector<double>(36, 0.0));
+  out.put("range.max_leverage", kNaN);
+  out.put("range.outside_blocks", 0.0);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -444,6 +455,9 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() < 6 && version == 6) {
+      return flow_law_from_5(upgraded_state(state, kind, 5));
+    }
     if (kind == "flow_law" && state.version() < 5 && version == 5) {
       return flow_law_from_4(upgraded_state(state, kind, 4));
     }

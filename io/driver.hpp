@@ -66,6 +66,10 @@ class Driver {
 
   // The source's own time for the last read, when it has one (replay: the capture's t).
   virtual std::optional<double> source_time() const { return std::nullopt; }
+  // Whether the samples of cycles the loop missed are lost: true for a live signal (a device,
+  // the simulated rig, which runs on); false for a stream that hands out its next sample when
+  // read late (a capture replayed row by row), so a late loop delays it and loses nothing.
+  virtual bool loses_missed_cycles() const { return true; }
 
   virtual DriverHealth health() const { return {}; }
 };

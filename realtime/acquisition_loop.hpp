@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "io/driver.hpp"
 #include "realtime/latency_histogram.hpp"
 #include "realtime/sample.hpp"
 #include "realtime/spsc_ring.hpp"
-#include "io/driver.hpp"
 
 namespace leakmon::realtime {
 
@@ -77,6 +77,10 @@ class AcquisitionLoop {
   std::vector<io::Driver*> drivers_;
   SpscRing<Sample>& ring_;
   std::size_t channel_count_ = 0;
+  // Whether a missed cycle is a gap in the samples (a driver of the group loses it) or only a
+  // delay (every driver a stream): Sample::tick skips the missed cycles only in the first case,
+  // and the worker marks skipped ticks as gaps.
+  bool missed_cycles_lose_samples_ = false;
   Sample sample_;  // built in place each cycle
   LoopCounters counters_;
 };

@@ -55,6 +55,8 @@ class CanlogDriver final : public Driver {
   void stop() override {}
   ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override;
+  // Paced by the log's clock, frames of missed cycles are passed; read by read (fast), none is.
+  bool loses_missed_cycles() const override { return pace_ == Pace::log; }
   DriverHealth health() const override;
 
   std::uint64_t error_frames() const { return error_frames_.load(); }

@@ -35,6 +35,7 @@ class ReplayDriver final : public Driver {
   void stop() override {}
   ReadStatus read(const Tick& tick, std::span<double> values) noexcept override;
   std::optional<double> source_time() const override { return source_time_; }
+  bool loses_missed_cycles() const override { return false; }  // the next row, however late
 
   std::size_t rows() const { return capture_ ? capture_->rows() : 0; }
   double sample_rate_hz() const;

@@ -58,9 +58,12 @@ TEST(DaemonProcess, ReloadAcknowledgeAndStopLoseNothing) {
   // The flow balance learns once each side of zero load has rested at loads spread beyond the
   // rest tolerance (issue 23): on this capture the first 6 s period does not, the second (to
   // 13.8 s) does, so the leak opens after that. It is judged at rests and raised about 9 s after
-  // the onset (t = 26.6 s). The wait for it is long and the capture longer (the replay loops at
-  // its end, which the recording check below would see): on a loaded machine (a sanitizer build
-  // beside another sanitizer test on two cores) the worker falls seconds behind the samples.
+  // the onset (t = 26.6 s). On a loaded machine (a sanitizer build beside another sanitizer test
+  // on two cores) the loop misses cycles: they once became gaps in the replayed stream, which
+  // moved the end of learning past the onset (37.8 s: the leak learned as healthy, never raised);
+  // a replay read late now loses nothing (RealtimeLoop.MissedCyclesAreGapsOnlyWhereADriverLost-
+  // TheirSamples) but runs late, so the wait is long and the capture longer (the replay loops at
+  // its end, which the recording check below would see).
   constexpr double kOnset = 18.0;
   sim::Scenario scenario = sim::preset("paper-fig10", 5);
   scenario.duration_s = 70.0;

@@ -128,5 +128,67 @@ TEST(RealtimeLoop, FiniteSourceEndsTheStream) {
   }
 }
 
+// A driver whose every 20th read takes 7 ms (3 periods of 2 ms and more): the loop misses cycles.
+// A stream (loses nothing when read late, as a replayed capture) or a live signal.
+class SlowDriver final : public io::Driver {
+ public:
+  explicit SlowDriver(bool live) : live_(live) {}
+  const std::string& name() const override { return name_; }
+  std::span<const std::string> channels() const override { return channels_; }
+  void start() override {}
+  void stop() override {}
+  io::ReadStatus read(const io::Tick&, std::span<double> values) noexcept override {
+    ++reads_;
+    if (reads_ % 20 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(7));
+    values[0] = static_cast<double>(reads_);
+    return io::ReadStatus::ok;
+  }
+  bool loses_missed_cycles() const override { return live_; }
+
+ private:
+  bool live_;
+  std::uint64_t reads_ = 0;
+  std::string name_ = "slow";
+  std::vector<std::string> channels_ = {"v"};
+};
+
+// Reads run late by the driver above, 200 samples; the ticks of the samples.
+std::vector<std::uint64_t> ticks_of_a_late_loop(bool live, std::uint64_t& missed) {
+  SlowDriver driver(live);
+  SpscRing<Sample> ring(512);
+  AcquisitionLoop loop(2'000'000, {&driver}, ring);
+  std::atomic<bool> stop{false};
+  std::thread acquisition([&] { loop.run(stop); });
+  while (loop.counters().samples_pushed.load() < 200) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stop = true;
+  acquisition.join();
+  missed = loop.counters().missed_cycles.load();
+  std::vector<std::uint64_t> ticks;
+  Sample sample;
+  while (ring.try_pop(sample)) ticks.push_back(sample.tick);
+  return ticks;
+}
+
+// A missed cycle is a gap downstream (the worker marks skipped ticks as missing samples) only
+// where a driver lost the cycle's sample. A stream read late (a replayed capture) lost nothing:
+// its ticks stay consecutive however late the loop runs, and the cycles are still counted.
+TEST(RealtimeLoop, MissedCyclesAreGapsOnlyWhereADriverLostTheirSamples) {
+  std::uint64_t missed = 0;
+  const std::vector<std::uint64_t> stream = ticks_of_a_late_loop(false, missed);
+  EXPECT_GE(missed, 10u);
+  ASSERT_GE(stream.size(), 200u);
+  for (std::size_t i = 1; i < stream.size(); ++i) ASSERT_EQ(stream[i], stream[i - 1] + 1) << i;
+
+  const std::vector<std::uint64_t> live = ticks_of_a_late_loop(true, missed);
+  EXPECT_GE(missed, 10u);
+  ASSERT_GE(live.size(), 200u);
+  std::uint64_t skipped = 0;
+  for (std::size_t i = 1; i < live.size(); ++i) skipped += live[i] - live[i - 1] - 1;
+  EXPECT_GE(skipped, 10u);
+  EXPECT_LE(skipped, missed);
+}
+
 }  // namespace
 }  // namespace leakmon::realtime
