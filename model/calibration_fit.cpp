@@ -3,10 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <optional>
 #include <unsupported/Eigen/LevenbergMarquardt>
+
+#include "model/recent_results.hpp"
 
 namespace leakmon::model {
 namespace {
@@ -119,20 +120,13 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   int operator()(const InputType& theta, ValueType& residuals) const {
     ++evaluations_;
     if (reuse_evaluations_) {
-      for (const auto& kept : recent_) {
-        if (same_point(kept.theta, theta)) {
-          residuals = kept.residuals;
-          return 0;
-        }
+      if (const ValueType* kept = recent_.find(theta)) {
+        residuals = *kept;
+        return 0;
       }
     }
     simulate(theta, residuals);
-    if (reuse_evaluations_) {
-      // The accepted point and the rejected trials after it.
-      constexpr std::size_t kKept = 4;
-      if (recent_.size() >= kKept) recent_.erase(recent_.begin());
-      recent_.push_back({theta, residuals});
-    }
+    if (reuse_evaluations_) recent_.keep(theta, residuals);
     return 0;
   }
 
@@ -163,16 +157,6 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
         model(theta), segments_,
         std::span<double>(residuals.data(), static_cast<std::size_t>(residuals.size())));
   }
-  static bool same_point(const InputType& a, const InputType& b) {
-    return a.size() == b.size() &&
-           std::memcmp(a.data(), b.data(), static_cast<std::size_t>(a.size()) * sizeof(double)) ==
-               0;
-  }
-
-  struct Evaluation {
-    InputType theta;
-    ValueType residuals;
-  };
   const SegmentPredictor& predictor_;
   std::span<const Segment> segments_;
   const EffectCandidate* candidate_;
@@ -181,7 +165,8 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   int calibration_slot_[kCalibrationCount] = {-1, -1, -1, -1};
   int first_effect_ = 0;
   bool reuse_evaluations_ = true;
-  mutable std::vector<Evaluation> recent_;  // newest last
+  // The accepted point and the rejected trials after it.
+  mutable RecentResults<InputType, ValueType, 4> recent_;
   mutable int evaluations_ = 0;
 };
 

@@ -1,7 +1,6 @@
 #include "model/segment_predictor.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -106,40 +105,25 @@ std::vector<double> SegmentPredictor::spool_positions(const ActuatorModel& model
 SegmentPredictor::SpoolLaw SegmentPredictor::spool_law(const ActuatorModel& model,
                                                        const ActuatorModel* before,
                                                        double onset_s) {
-  SpoolLaw law;
-  law.values = {model.spool_tau(), model.coefficients().u_bias, model.coefficients().u_max};
+  SpoolLaw law = {model.spool_tau(), model.coefficients().u_bias, model.coefficients().u_max};
   if (before) {
     // A spool whose tau is zero does not exist, so the zeros left without an onset cannot
     // stand for a model before one.
-    law.values[3] = before->spool_tau();
-    law.values[4] = before->coefficients().u_bias;
-    law.values[5] = before->coefficients().u_max;
-    law.values[6] = onset_s;
+    law[3] = before->spool_tau();
+    law[4] = before->coefficients().u_bias;
+    law[5] = before->coefficients().u_max;
+    law[6] = onset_s;
   }
   return law;
 }
 
-bool SegmentPredictor::SpoolLaw::same_as(const SpoolLaw& other) const {
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (std::bit_cast<std::uint64_t>(values[i]) != std::bit_cast<std::uint64_t>(other.values[i]))
-      return false;
-  }
-  return true;
-}
-
 std::shared_ptr<const std::vector<double>> SegmentPredictor::shared_spool_positions(
     const ActuatorModel& model, const ActuatorModel* before, double onset_s) const {
-  // A handful: a fit alternates between at most a few laws (a model before and after an
-  // onset, the floor's model between fits); more would only hold memory.
-  constexpr std::size_t kKept = 4;
   const SpoolLaw law = spool_law(model, before, onset_s);
-  for (const auto& kept : spool_runs_) {
-    if (kept.law.same_as(law)) return kept.positions;
-  }
+  if (const auto* kept = spool_runs_.find(law)) return *kept;
   auto positions =
       std::make_shared<const std::vector<double>>(spool_positions(model, before, onset_s));
-  if (spool_runs_.size() >= kKept) spool_runs_.erase(spool_runs_.begin());
-  spool_runs_.push_back({law, positions});
+  spool_runs_.keep(law, positions);
   return positions;
 }
 

@@ -16,6 +16,7 @@
 
 #include "model/actuator_model.hpp"
 #include "model/measured_record.hpp"
+#include "model/recent_results.hpp"
 #include "sim/parameters.hpp"
 
 namespace leakmon::model {
@@ -129,18 +130,13 @@ class SegmentPredictor {
   std::vector<double> dp1_, dp2_;  // central differences of the pressure readings
   // Everything spool_positions reads from its models (the spool's tau, u0 and u_max, then the
   // same before an onset and the onset's time; zeros without one): equal laws give equal
-  // positions. Compared bit for bit, so that a -0 bias is not taken for a +0 one.
-  struct SpoolLaw {
-    std::array<double, 7> values{};
-    bool same_as(const SpoolLaw& other) const;
-  };
+  // positions (compared bit for bit, recent_results.hpp).
+  using SpoolLaw = std::array<double, 7>;
   static SpoolLaw spool_law(const ActuatorModel& model, const ActuatorModel* before,
                             double onset_s);
-  struct SpoolRun {
-    SpoolLaw law;
-    std::shared_ptr<const std::vector<double>> positions;
-  };
-  mutable std::vector<SpoolRun> spool_runs_;  // newest last
+  // A handful: a fit alternates between at most a few laws (a model before and after an onset,
+  // the floor's model between fits); more would only hold memory.
+  mutable RecentResults<SpoolLaw, std::shared_ptr<const std::vector<double>>, 4> spool_runs_;
 };
 
 }  // namespace leakmon::model
