@@ -40,9 +40,9 @@ TEST(MqttOutput, DeliversEveryEventInOrderWhileOtherThreadsReadAndSample) {
   const std::string dir = test::scratch_dir("mqtt_output_threads");
   test::Broker broker(dir, test::free_port());
   test::Subscriber subscriber(broker.port(), dir + "/received.txt", "leakmon-test-inproc");
-  auto sink = make_mqtt_output_with(settings_for(dir, broker.port()));
-
+  // Declared before the output, so destroyed after it: its thread samples until it is gone.
   std::atomic<int> samplings{0};
+  auto sink = make_mqtt_output_with(settings_for(dir, broker.port()));
   sink->attach_readings([&samplings] {
     ++samplings;
     // The message as the daemon formats it from its snapshot (views/status_json.hpp
