@@ -347,6 +347,20 @@ TEST(FlowLaw, ATriangleIsLearnedAFastSineWaits) {
   EXPECT_LT(later.max_score, detector.raise_threshold());
 }
 
+// Run 7's program in short: a slow 6 s triangle of 35 mm (learned on), then a 0.46-2.5 Hz sweep
+// of 27 mm, fault-tolerant controller.
+constexpr double kTriangleSeconds = 150.0, kSweepSeconds = 140.0;
+capture::Capture triangle_then_fast_sweep() {
+  sim::Phase triangle = phase(sim::PhaseKind::triangle, kTriangleSeconds);
+  triangle.P = 6.0;
+  triangle.A = 0.035;
+  sim::Phase sweep = phase(sim::PhaseKind::sweep, 0.0);
+  sweep.F0 = 0.46;
+  sweep.F1 = 2.5;
+  sweep.A = 0.027;
+  return sim::simulate(program(7, {triangle, sweep}, kTriangleSeconds + kSweepSeconds));
+}
+
 // A model learned on a slow triangle judges a fast sweep (run 7 of `evaluate --conditions
 // programs --seed 2531`: a 6 s triangle, then a 0.46-2.5 Hz sweep of 27 mm that raised 273 s in).
 // A triangle opens the valve slowly and shows little of the spool's lag; the sweep's lag term is
@@ -355,17 +369,8 @@ TEST(FlowLaw, ATriangleIsLearnedAFastSineWaits) {
 // learning leverage are not judged and say so; the triangle after learning, and the sweep's slow
 // start, are judged; nothing raises. With the guard off every block is judged.
 TEST(FlowLaw, AFastSweepBeyondWhatATriangleTaughtIsNotJudged) {
-  sim::Phase triangle = phase(sim::PhaseKind::triangle, 150.0);
-  triangle.P = 6.0;
-  triangle.A = 0.035;
-  sim::Phase sweep = phase(sim::PhaseKind::sweep, 0.0);
-  sweep.F0 = 0.46;
-  sweep.F1 = 2.5;
-  sweep.A = 0.027;
-  constexpr double kSweepSeconds = 140.0;
-  const capture::Capture capture =
-      sim::simulate(program(7, {triangle, sweep}, 150.0 + kSweepSeconds));
-  const std::size_t sweep_row = 150 * 500;
+  const capture::Capture capture = triangle_then_fast_sweep();
+  const std::size_t sweep_row = static_cast<std::size_t>(kTriangleSeconds * 500.0);
   FlowLawDetector detector = make();
   const Outcome in_triangle = run(detector, capture, 1e9, 0, sweep_row);
   EXPECT_GT(in_triangle.learned_at, 90.0);
@@ -828,14 +833,7 @@ TEST(FlowLaw, LayoutFourLearnsWithoutTheNullOffsetOnlyWhenItHadLearningBlocks) {
 // Layout 5 kept no learned range: loaded, it judges every block as its build did, on the state's
 // own coefficients; after a reset it learns the range again.
 TEST(FlowLaw, LayoutFiveLoadsWithoutARangeAndJudgesEveryBlock) {
-  sim::Phase triangle = phase(sim::PhaseKind::triangle, 150.0);
-  triangle.P = 6.0;
-  triangle.A = 0.035;
-  sim::Phase sweep = phase(sim::PhaseKind::sweep, 0.0);
-  sweep.F0 = 0.46;
-  sweep.F1 = 2.5;
-  sweep.A = 0.027;
-  const capture::Capture capture = sim::simulate(program(7, {triangle, sweep}, 290.0));
+  const capture::Capture capture = triangle_then_fast_sweep();
   FlowLawOptions layout_five;
   layout_five.max_leverage_ratio = 0.0;
   FlowLawDetector writer = make(layout_five);
