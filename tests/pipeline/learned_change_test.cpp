@@ -54,6 +54,8 @@ TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
   EXPECT_NE(found.front().message.find("learning may have included a leak at t="),
             std::string::npos)
       << found.front().message;
+  EXPECT_NE(found.front().message.find("the valve's flow rose with the load"), std::string::npos)
+      << found.front().message;
   // The event log's JSON carries the time and the feature.
   const std::string json = to_json_line(found.front());
   EXPECT_NE(json.find("\"event\": \"learned_change\""), std::string::npos) << json;
