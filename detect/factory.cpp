@@ -442,11 +442,6 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               "the largest learning block's is not judged (outside the learned "
                               "range); 0: every block is judged",
                               [](O& o) -> double& { return o.max_leverage_ratio; }),
-             number_option<O>("range_extension_seconds", 0.0, kMaxOptionSeconds,
-                              "blocks outside the learned range gathered this long are fitted "
-                              "with the learned ones, their own load term free; the range is "
-                              "extended to them when that term is below min_leak [s]; 0: never",
-                              [](O& o) -> double& { return o.range_extension_seconds; }),
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
                               [](O& o) -> double& { return o.rest_speed; }),

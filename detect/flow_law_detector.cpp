@@ -75,13 +75,6 @@ FlowLawDetector::FlowLawDetector(const FlowLawOptions& options, double hop_secon
   learned_.reserve(learn_capacity_);
   probe_blocks_.reserve(learn_capacity_);
   rest_loads_.reserve(learn_capacity_);
-  extension_blocks_ =
-      options.range_extension_seconds > 0.0
-          ? std::max<std::size_t>(2 * kRegressors,
-                                  static_cast<std::size_t>(std::ceil(
-                                      options.range_extension_seconds / options.block_seconds)))
-          : 0;
-  outside_.reserve(extension_blocks_);
 }
 
 void FlowLawDetector::reset_spool_time_constant() {
@@ -100,8 +93,6 @@ void FlowLawDetector::reset() {
   inverse_normal_.setZero();
   max_learned_leverage_ = kMissing;
   outside_range_blocks_ = 0;
-  outside_.clear();
-  range_extension_ = RangeExtension{};
   reset_spool_time_constant();
   fit_null_offset_ = options_.learn_null_offset;
   supply_ = viscosity_ratio_ = kMissing;
@@ -498,10 +489,6 @@ void FlowLawDetector::judge(const Block& b) {
   if (outside_learned_range(b)) {
     ++outside_range_blocks_;
     block_reason_ = NotJudgedReason::outside_learned_regime;
-    if (extension_blocks_ > 0) {
-      outside_.push_back(b);
-      if (outside_.size() == extension_blocks_) extend_learned_range();
-    }
     return;
   }
   last_judged_t_ = b.t;
@@ -550,96 +537,6 @@ bool FlowLawDetector::outside_learned_range(const Block& b) const {
   // range has no extent along it and it does not count.
   if (!fit_null_offset_) x[5] = 0.0;
   return x.dot(inverse_normal_ * x) > options_.max_leverage_ratio * max_learned_leverage_;
-}
-
-// A model learned on a slow triangle does not judge a fast sweep after it (its spool-lag term is
-// extrapolated there); a rig's program changes within a shift. The learned blocks are gone, but
-// their normal equations are not: X'X is the inverse of the kept (X'X)^-1 and X'y = X'X c. The
-// gathered blocks outside the range join them with one more regressor, their own load term g
-// (zero on the learned blocks): every coefficient the new program shares with the old is refitted
-// on both (the lag's above all), and whatever the new blocks do along the load that the shared
-// model does not, a leak that opened with the new program or the model's bias there, goes to g
-// and not to the cross-port term. Extended only when g is told apart within `min_leak` and is
-// smaller than it: judged from then on with the shared coefficients, a leak in the new program
-// still shows in full. Otherwise nothing is learned (a leak is never learned as healthy) and the
-// oldest half of the gathered blocks makes room for the next.
-void FlowLawDetector::extend_learned_range() {
-  constexpr int kAll = kRegressors + 1;
-  using Normal = Eigen::Matrix<double, kAll, kAll>;
-  using Vector = Eigen::Matrix<double, kAll, 1>;
-  const auto drop_oldest_half = [this] {
-    outside_.erase(outside_.begin(),
-                   outside_.begin() + static_cast<std::ptrdiff_t>(outside_.size() / 2));
-  };
-  ++range_extension_.attempts;
-  const Eigen::Matrix<double, kRegressors, kRegressors> learned_normal =
-      inverse_normal_.ldlt().solve(Eigen::Matrix<double, kRegressors, kRegressors>::Identity());
-  Normal normal = Normal::Zero();
-  Vector xty = Vector::Zero();
-  normal.topLeftCorner<kRegressors, kRegressors>() = learned_normal;
-  xty.head<kRegressors>() = learned_normal * coefficients_;
-  for (const auto& b : outside_) {
-    Vector x;
-    x << regressors(b), b.load;
-    if (!fit_null_offset_) x[5] = 0.0;
-    normal.noalias() += x * x.transpose();
-    xty += x * b.y;
-  }
-  const double ridge = 1e-9 * (normal.trace() / kAll + 1e-300);
-  normal.diagonal().array() += ridge;
-  const Eigen::LDLT<Normal> solver(normal);
-  const Vector fitted = solver.solve(xty);
-  const Normal inverse = solver.solve(Normal::Identity());
-  // The new blocks' spread about the joint fit (their own load term included).
-  double sum_sq = 0.0, sum_lag = 0.0, previous = 0.0, previous_t = kMissing;
-  for (const auto& b : outside_) {
-    Vector x;
-    x << regressors(b), b.load;
-    if (!fit_null_offset_) x[5] = 0.0;
-    const double r = b.y - fitted.dot(x);
-    sum_sq += r * r;
-    if (std::abs(b.t - previous_t - options_.block_seconds) < 0.5 * options_.block_seconds) {
-      sum_lag += r * previous;
-    }
-    previous = r;
-    previous_t = b.t;
-  }
-  const double new_sigma =
-      cusum_block_sigma(std::sqrt(sum_sq / static_cast<double>(outside_.size() - kRegressors)),
-                        outside_.size(), sum_sq > 0.0 ? lag_one_correlation(sum_lag, sum_sq) : 0.0);
-  const double sigma = std::max(block_sigma_, new_sigma);
-  const double a = coefficients_[0];
-  const double to_leak = flow_unit_ / options_.rig.ps / a;
-  const double added = fitted[kRegressors] / a;  // in the load regressor's slope units
-  const double added_error =
-      sigma * std::sqrt(std::max(inverse(kRegressors, kRegressors), 0.0)) / std::abs(a);
-  range_extension_.added_leak = added * to_leak * a;
-  range_extension_.added_leak_error = added_error * std::abs(to_leak * a);
-  // Told apart: two standard errors within the floor. Against a leak's sign beyond the floor the
-  // shared model does not describe the new program (a leak only adds flow): not extended. Along
-  // it, the load term the new blocks add stays out of the shared coefficients and so in their
-  // residuals: judged from now on, a leak that opened with the new program raises.
-  if (!(2.0 * added_error < floor_slope_) || !(added > -floor_slope_) || !(a * fitted[0] > 0.0)) {
-    drop_oldest_half();
-    return;
-  }
-  // The shared model, fitted on the learned blocks and the new ones (without g: the range is the
-  // one the shared coefficients were fitted on).
-  const Eigen::Matrix<double, kRegressors, kRegressors> shared_normal =
-      normal.topLeftCorner<kRegressors, kRegressors>();
-  const Eigen::Matrix<double, kRegressors, kRegressors> shared_inverse =
-      shared_normal.ldlt().solve(Eigen::Matrix<double, kRegressors, kRegressors>::Identity());
-  coefficients_ = fitted.head<kRegressors>();
-  inverse_normal_ = shared_inverse;
-  // A learned block's leverage can only fall with more blocks: the old largest bounds them.
-  for (const auto& b : outside_) {
-    Coefficients x = regressors(b);
-    if (!fit_null_offset_) x[5] = 0.0;
-    max_learned_leverage_ = std::max(max_learned_leverage_, x.dot(inverse_normal_ * x));
-  }
-  block_sigma_ = sigma;
-  ++range_extension_.extensions;
-  outside_.clear();
 }
 
 // The CUSUM leaves zero on the noise of healthy blocks too, so its run holds blocks from before

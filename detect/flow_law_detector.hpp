@@ -92,13 +92,6 @@ struct FlowLawOptions {
   // triangle extrapolates the spool lag's term); the status says `outside_learned_regime`.
   // 0: every block is judged (the build before).
   double max_leverage_ratio = 2.0;
-  // Blocks outside the learned range are gathered; once this many seconds of them are, the model
-  // is refitted on the learned blocks' normal equations and the new ones together, with the new
-  // blocks' load term free of its own (a leak that opened with the new program, or the model's
-  // bias there, would show in it). The range is extended to them when that term is told apart
-  // from the others within `min_leak` and lies within it; else the oldest half is dropped and
-  // the next ones gathered (docs/detection.md). 0: never extended (the build before).
-  double range_extension_seconds = 30.0;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -133,14 +126,6 @@ class FlowLawDetector final : public Detector {
   // The largest leverage among the learning blocks (NaN before learning, or from a layout-5
   // state, which judges every block as its build did).
   double max_learned_leverage() const { return max_learned_leverage_; }
-  // How often the learned range was extended to a new program since construction, reset or
-  // restore, and what the latest attempt found: the new blocks' own load slope and its standard
-  // error in m^3/(s Pa) (NaN before any attempt; diagnostics and tests, not saved).
-  struct RangeExtension {
-    std::size_t attempts = 0, extensions = 0;
-    double added_leak = kMissing, added_leak_error = kMissing;
-  };
-  RangeExtension range_extension() const { return range_extension_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
@@ -250,11 +235,6 @@ class FlowLawDetector final : public Detector {
   double max_learned_leverage_ = kMissing;
   std::size_t outside_range_blocks_ = 0;
   bool outside_learned_range(const Block& b) const;
-  // The blocks outside the range gathered for its extension (reserved at construction).
-  std::vector<Block> outside_;
-  std::size_t extension_blocks_ = 0;  // range_extension_seconds in blocks (0: off)
-  RangeExtension range_extension_;
-  void extend_learned_range();
   bool waiting_ = false;
   Excitation excitation_;
   std::vector<double> rest_loads_;  // scratch, reserved as learned_
