@@ -6,10 +6,14 @@
 #include <vector>
 
 #include "detect/factory.hpp"
+#include "sim/simulate.hpp"
 #include "tests/detect/synthetic_pressures.hpp"
 #include "tests/detect/synthetic_rig.hpp"
 
 namespace {
+
+namespace sim = leakmon::sim;
+namespace capture = leakmon::capture;
 
 void detector_update(benchmark::State& state, const std::string& kind) {
   auto detector = leakmon::detect::make_detector(kind, {true, true, true, true}, 0.04, nullptr);
@@ -54,10 +58,59 @@ void detail_xcorr_update(benchmark::State& state, bool both_chambers) {
   }
 }
 
+// flow_law (the default with u and x) integrates the valve's flow sample by sample, so it runs on
+// the simulated rig's own samples (the paper's steps, 300 s, a 1e-12 leak from 200 s): the hops
+// as the worker forms them, means and the hop's 20 samples per signal.
+void flow_law_update(benchmark::State& state) {
+  constexpr std::size_t kStep = 20;
+  sim::Scenario scenario;
+  scenario.duration_s = 300.0;
+  scenario.seed = 5;
+  sim::InternalLeakage leak;
+  leak.C_L = 1e-12;
+  leak.onset_s = 200.0;
+  scenario.effects.internal_leakage = leak;
+  const capture::Capture capture = sim::simulate(scenario);
+  const auto& t = capture.column("t");
+  const auto& u = capture.column("u");
+  const auto& x = capture.column("x");
+  const auto& p1 = capture.column("p1");
+  const auto& p2 = capture.column("p2");
+  std::vector<leakmon::detect::Observation> stream;
+  for (std::size_t start = 0; start + kStep <= capture.rows(); start += kStep) {
+    leakmon::detect::Observation o;
+    o.t = t[start + kStep - 1];
+    auto mean = [&](const std::vector<double>& column) {
+      double sum = 0.0;
+      for (std::size_t i = start; i < start + kStep; ++i) sum += column[i];
+      return sum / static_cast<double>(kStep);
+    };
+    o.u = mean(u);
+    o.x = mean(x);
+    o.p1 = mean(p1);
+    o.p2 = mean(p2);
+    o.u_samples = {u.data() + start, kStep};
+    o.x_samples = {x.data() + start, kStep};
+    o.p1_samples = {p1.data() + start, kStep};
+    o.p2_samples = {p2.data() + start, kStep};
+    stream.push_back(o);
+  }
+  auto detector =
+      leakmon::detect::make_detector("flow_law", {true, true, true, true}, 0.04, nullptr);
+  const std::size_t learned = stream.size() / 2;  // 150 s: past learning on the steps
+  std::size_t next = 0;
+  for (; next < learned; ++next) detector->update(stream[next]);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(detector->update(stream[next]));
+    if (++next == stream.size()) next = learned;
+  }
+}
+
 BENCHMARK_CAPTURE(detector_update, paper, std::string("paper"));
 BENCHMARK_CAPTURE(detector_update, index_cusum, std::string("index_cusum"));
 BENCHMARK_CAPTURE(detector_update, flow_balance, std::string("flow_balance"));
 BENCHMARK_CAPTURE(detector_update, fused, std::string("fused"));
+BENCHMARK(flow_law_update);
 BENCHMARK_CAPTURE(detail_xcorr_update, detail_xcorr, true);
 BENCHMARK_CAPTURE(detail_xcorr_update, detail_xcorr_p1, false);
 

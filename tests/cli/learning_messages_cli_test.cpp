@@ -49,7 +49,7 @@ TEST(LearningMessages, ReplaySaysWhichDetectorRanAndThatItWasStillLearning) {
   const Invocation replay =
       run("replay --in " + dir + "/fig10.csv --events " + dir + "/events.jsonl");
   ASSERT_EQ(replay.status, 0) << replay.output;
-  EXPECT_NE(replay.output.find("actuator: detector flow_balance (default for p1, p2, u, x); "
+  EXPECT_NE(replay.output.find("actuator: detector flow_law (default for p1, p2, u, x); "
                                "learns the healthy rig during its first "),
             std::string::npos)
       << replay.output;
@@ -100,7 +100,7 @@ TEST(LearningMessages, RunLogsTheDetectorAndTheEndOfLearning) {
   // starts over.
   const Invocation daemon = run("run --config " + config + " --duration 30");
   ASSERT_EQ(daemon.status, 0) << daemon.output;
-  EXPECT_NE(daemon.output.find("cylinder: detector flow_balance (default for p1, p2, u, x); "
+  EXPECT_NE(daemon.output.find("cylinder: detector flow_law (default for p1, p2, u, x); "
                                "learns the healthy rig during its first 11.8 s of data"),
             std::string::npos)
       << daemon.output;

@@ -882,13 +882,13 @@ TEST(FlowLaw, UpdateAllocatesNothingAndResetStartsLearningAgain) {
   EXPECT_FALSE(std::isnan(again.last.learning_hops_left));
 }
 
-// Reachable through the registry by name, needs u and x, and is not the default yet (a cold start
-// with `temp` raised where flow_balance did not: docs/detection.md).
+// Reachable through the registry by name, needs u and x, and is the default with them (issue 23:
+// it judges in every program, where flow_balance judges only at rest).
 TEST(FlowLaw, RegistryKind) {
   AvailableSignals all;
   all.p1 = all.p2 = all.u = all.x = true;
   EXPECT_EQ(make_detector("flow_law", all, kHop, nullptr, nullptr)->name(), "flow_law");
-  EXPECT_NE(default_detector_kind(all), "flow_law");
+  EXPECT_EQ(default_detector_kind(all), "flow_law");
   AvailableSignals pressures;
   pressures.p1 = pressures.p2 = true;
   EXPECT_THROW(make_detector("flow_law", pressures, kHop, nullptr, nullptr), std::invalid_argument);

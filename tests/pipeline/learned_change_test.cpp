@@ -46,7 +46,7 @@ TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
   const auto found = learned_changes(flow);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found.front().channel, "u");
-  EXPECT_EQ(found.front().feature, "command_residual");
+  EXPECT_EQ(found.front().feature, "flow_residual");
   EXPECT_NEAR(found.front().change_t, kOnset, 3.0);
   // Sized as a leak: within a factor of two of the truth (the reference is 36 s of data).
   EXPECT_GT(found.front().leak_coefficient, 1e-12);
@@ -54,11 +54,13 @@ TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
   EXPECT_NE(found.front().message.find("learning may have included a leak at t="),
             std::string::npos)
       << found.front().message;
+  EXPECT_NE(found.front().message.find("the valve's flow rose with the load"), std::string::npos)
+      << found.front().message;
   // The event log's JSON carries the time and the feature.
   const std::string json = to_json_line(found.front());
   EXPECT_NE(json.find("\"event\": \"learned_change\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"change_t\": "), std::string::npos) << json;
-  EXPECT_NE(json.find("\"feature\": \"command_residual\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"feature\": \"flow_residual\""), std::string::npos) << json;
 }
 
 // `detector: flow_law` looks back with its own residual (the valve's flow in any motion) and says

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "detect/factory.hpp"
 #include "pipeline/replay.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
@@ -236,6 +237,40 @@ TEST(ReplayStateDir, ALeakOpenedWhileDownIsFoundOnlyWhenTheStateWasKept) {
   ASSERT_EQ(discarded.size(), 1u);
   EXPECT_NE(discarded.front().message.find("truncated"), std::string::npos);
   EXPECT_TRUE(of_kind(fresh, io::EventKind::state_restored).empty());
+}
+
+// Upgrading from a build whose default with u and x was flow_balance: the state that build saved
+// for a `default` actuator is set aside with one event that names the change, and the actuator
+// learns again (flow_law); nothing is read into the other detector.
+TEST(ReplayStateDir, TheOldDefaultsFlowBalanceStateIsSetAsideAndLearnedAgain) {
+  const std::string dir = fresh_dir("ReplayStateDirUpgrade");
+  const capture::Capture first = capture_of(31, 110.0, 0.0);
+  const capture::Capture next = capture_of(32, 110.0, 0.0);
+  DaemonConfig old_default = default_replay_config(first);
+  ASSERT_EQ(old_default.actuators.size(), 1u);
+  old_default.actuators.front().detector = "flow_balance";  // what `default` was
+  ReplayOptions keep;
+  keep.state_directory = dir;
+  const ReplayResult learned = replay_capture(first, old_default, keep);
+  ASSERT_FALSE(learned.actuators.front().learning);
+  ASSERT_NE(read(StateStore(dir).file_of("actuator")).find("flow_balance"), std::string::npos);
+
+  const ReplayResult upgraded = replay_capture(next, default_replay_config(next), keep);
+  const auto discarded = of_kind(upgraded, io::EventKind::state_discarded);
+  ASSERT_EQ(discarded.size(), 1u);
+  EXPECT_NE(discarded.front().message.find("detector: 'flow_balance' -> 'flow_law'"),
+            std::string::npos)
+      << discarded.front().message;
+  EXPECT_NE(discarded.front().message.find("learning afresh"), std::string::npos);
+  EXPECT_TRUE(of_kind(upgraded, io::EventKind::state_restored).empty());
+  EXPECT_EQ(upgraded.actuators.front().detector, "flow_law");
+  EXPECT_TRUE(of_kind(upgraded, io::EventKind::alarm_raised).empty());
+
+  EXPECT_NE(read(StateStore(dir).file_of("actuator")).find("flow_law"), std::string::npos);
+
+  // Whatever the fingerprint says, flow_law refuses a flow_balance state rather than misread it.
+  const auto law = detect::make_detector("default", {true, true, true, true}, 0.04, nullptr);
+  EXPECT_THROW(law->import_state(detect::DetectorState("flow_balance", 4)), detect::StateError);
 }
 
 }  // namespace
