@@ -19,7 +19,7 @@
 namespace leakmon::pipeline {
 namespace {
 
-constexpr double kStepsStart = 300.0, kSineStart = 600.0, kSineEnd = 900.0;
+constexpr double kStepsStart = 300.0, kSineStart = 600.0;
 
 const capture::Capture& shift() {
   static const capture::Capture capture = sim::simulate(
