@@ -9,6 +9,7 @@
 #include "sim/simulate.hpp"
 #include "tests/detect/synthetic_pressures.hpp"
 #include "tests/detect/synthetic_rig.hpp"
+#include "tests/support/hop_observation.hpp"
 
 namespace {
 
@@ -71,29 +72,9 @@ void flow_law_update(benchmark::State& state) {
   leak.onset_s = 200.0;
   scenario.effects.internal_leakage = leak;
   const capture::Capture capture = sim::simulate(scenario);
-  const auto& t = capture.column("t");
-  const auto& u = capture.column("u");
-  const auto& x = capture.column("x");
-  const auto& p1 = capture.column("p1");
-  const auto& p2 = capture.column("p2");
   std::vector<leakmon::detect::Observation> stream;
   for (std::size_t start = 0; start + kStep <= capture.rows(); start += kStep) {
-    leakmon::detect::Observation o;
-    o.t = t[start + kStep - 1];
-    auto mean = [&](const std::vector<double>& column) {
-      double sum = 0.0;
-      for (std::size_t i = start; i < start + kStep; ++i) sum += column[i];
-      return sum / static_cast<double>(kStep);
-    };
-    o.u = mean(u);
-    o.x = mean(x);
-    o.p1 = mean(p1);
-    o.p2 = mean(p2);
-    o.u_samples = {u.data() + start, kStep};
-    o.x_samples = {x.data() + start, kStep};
-    o.p1_samples = {p1.data() + start, kStep};
-    o.p2_samples = {p2.data() + start, kStep};
-    stream.push_back(o);
+    stream.push_back(leakmon::test::hop_observation(capture, start, kStep));
   }
   auto detector =
       leakmon::detect::make_detector("flow_law", {true, true, true, true}, 0.04, nullptr);

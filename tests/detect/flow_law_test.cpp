@@ -14,6 +14,7 @@
 #include "detect/flow_law_detector.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/alloc_counter.hpp"
+#include "tests/support/hop_observation.hpp"
 
 namespace leakmon::detect {
 namespace {
@@ -50,34 +51,10 @@ sim::Scenario program(std::uint64_t seed, const std::vector<sim::Phase>& phases,
 Outcome run(FlowLawDetector& detector, const capture::Capture& capture, double onset,
             std::size_t first_row = 0, std::size_t end_row = 0,
             std::uint64_t* allocations = nullptr) {
-  const auto& t = capture.column("t");
-  const auto& u = capture.column("u");
-  const auto& x = capture.column("x");
-  const auto& p1 = capture.column("p1");
-  const auto& p2 = capture.column("p2");
-  // The supply and the oil's temperature where the capture records them.
-  const std::vector<double>* ps = capture.has("ps") ? &capture.column("ps") : nullptr;
-  const std::vector<double>* temp = capture.has("temp") ? &capture.column("temp") : nullptr;
   if (end_row == 0) end_row = capture.rows();
   Outcome outcome;
   for (std::size_t start = first_row; start + kStep <= end_row; start += kStep) {
-    auto mean = [&](const std::vector<double>& column) {
-      double sum = 0.0;
-      for (std::size_t i = start; i < start + kStep; ++i) sum += column[i];
-      return sum / static_cast<double>(kStep);
-    };
-    Observation o;
-    o.t = t[start + kStep - 1];
-    o.u = mean(u);
-    o.x = mean(x);
-    o.p1 = mean(p1);
-    o.p2 = mean(p2);
-    if (ps != nullptr) o.ps = mean(*ps);
-    if (temp != nullptr) o.temp = mean(*temp);
-    o.u_samples = {u.data() + start, kStep};
-    o.x_samples = {x.data() + start, kStep};
-    o.p1_samples = {p1.data() + start, kStep};
-    o.p2_samples = {p2.data() + start, kStep};
+    const Observation o = test::hop_observation(capture, start, kStep);
     {
       test::AllocationScope scope;
       outcome.last = detector.update(o);
