@@ -393,6 +393,10 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                  },
                  0.0, 0.0,
                  [](O& o) { return std::string(o.learn_spool_time_constant ? "true" : "false"); }),
+             number_option<O>("min_lag_share", 0.0, 1.0,
+                              "... when, of the lag's spread over the learning blocks the other "
+                              "terms leave, the load term leaves this share; else the stated lag",
+                              [](O& o) -> double& { return o.min_lag_share; }),
              other_option<O>(
                  "learn_null_offset", "", "true, false",
                  "learn the valve's null-offset flow (a bias the command u does not show)",
@@ -409,7 +413,7 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               [](O& o) -> double& { return o.min_load_spread; }),
              number_option<O>("min_rest_loads", 0.0, 100.0,
                               "... and until its blocks at rest lie at this many distinct loads, "
-                              "or its motion identifies the load term (min_motion_load_share); "
+                              "or 3/4 of them move (and min_motion_load_share holds); "
                               "0: the spread alone",
                               [](O& o) -> double& { return o.min_rest_loads; }),
              number_option<O>("rest_load_tolerance", 1e3, 1e8,
@@ -418,7 +422,8 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
              number_option<O>("min_motion_load_share", 0.0, 1.0,
                               "with 3/4 of the learning blocks moving: the share of their load "
                               "term's spread the swept and compressed volumes must leave "
-                              "unexplained (1 - R^2) for motion to identify it",
+                              "unexplained (1 - R^2) for motion to identify it; 0: moving is "
+                              "enough (the learned range keeps other programs from being judged)",
                               [](O& o) -> double& { return o.min_motion_load_share; }),
              number_option<O>(
                  "min_load", 0.0, 1e9,
@@ -442,6 +447,11 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               "the largest learning block's is not judged (outside the learned "
                               "range); 0: every block is judged",
                               [](O& o) -> double& { return o.max_leverage_ratio; }),
+             number_option<O>("range_extension_seconds", 0.0, kMaxOptionSeconds,
+                              "blocks outside the learned range gathered this long are fitted "
+                              "with the learned ones, their own load term free; the range is "
+                              "extended to them when that term is below min_leak [s]; 0: never",
+                              [](O& o) -> double& { return o.range_extension_seconds; }),
              number_option<O>("rest_speed", 1e-6, 10.0,
                               "without `ps`: hops slower than this read the supply [m/s]",
                               [](O& o) -> double& { return o.rest_speed; }),

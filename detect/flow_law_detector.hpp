@@ -61,13 +61,15 @@ struct FlowLawOptions {
   double min_load_spread = 0.3e6;
   // ... and only when the learning blocks at rest lie at `min_rest_loads` loads p1 - p2 further
   // apart than `rest_load_tolerance` [Pa] (steps), or when at least kMotionBlockShare of them move
-  // and their motion identifies the load term: the share of the moving blocks' load-term spread
-  // that the swept and compressed volumes and the block length do not explain is at least
-  // `min_motion_load_share` (triangles; a fast sine's load term is nearly a mix of the volumes).
-  // 0 rest loads: the spread above alone (the build before issue 23's wait).
+  // and the share of their load term's spread that the swept and compressed volumes and the
+  // block length do not explain is at least `min_motion_load_share`. A fast sine's load term is
+  // nearly a mix of the volumes (share 0.26; triangles 0.99): its model says little about the
+  // load term elsewhere, but the learned range (max_leverage_ratio) keeps it from judging other
+  // programs, so by default (0) moving blocks are enough and a rig running fast sines is judged
+  // in them. 0 rest loads: the spread above alone (the build before issue 23's wait).
   double min_rest_loads = 3.0;
   double rest_load_tolerance = 0.3e6;
-  double min_motion_load_share = 0.9;
+  double min_motion_load_share = 0.0;
   // A block with |mean p1 - p2| below this is not judged (no load, no leak flow) [Pa].
   double min_load = 0.3e6;
   // Scaled by the factory with Kv / 3.39e-7, as flow_balance's.
@@ -84,6 +86,11 @@ struct FlowLawOptions {
   // Learn the spool's time constant from the learning blocks (a ladder of kTauCandidates values,
   // a third of an octave apart around rig.tau); false keeps rig.tau.
   bool learn_spool_time_constant = true;
+  // ... but only when the learning blocks tell the lag from the load term: of the lag regressor's
+  // spread that the other regressors leave unexplained, the load term must leave at least this
+  // share (a slow sine: 0.04, where the lag follows the spring's load; steps 0.98, triangles
+  // 0.75). Else the stated lag is kept.
+  double min_lag_share = 0.25;
   // Fit the valve's null-offset flow (the sixth regressor); false: the model before it.
   bool learn_null_offset = true;
   // A block whose leverage on the learned fit (x' (X'X)^-1 x over the learning blocks' regressors)
@@ -92,6 +99,13 @@ struct FlowLawOptions {
   // triangle extrapolates the spool lag's term); the status says `outside_learned_regime`.
   // 0: every block is judged (the build before).
   double max_leverage_ratio = 2.0;
+  // Blocks outside the learned range are gathered; once this many seconds of them are, the model
+  // is refitted on the learned blocks' normal equations and the new ones together, with the new
+  // blocks' load term free of its own (a leak that opened with the new program, or the model's
+  // bias there, would show in it). The range is extended to them when that term is told apart
+  // from the others within `min_leak` and lies within it; else the oldest half is dropped and
+  // the next ones gathered (docs/detection.md). 0: never extended (the build before).
+  double range_extension_seconds = 30.0;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -126,6 +140,14 @@ class FlowLawDetector final : public Detector {
   // The largest leverage among the learning blocks (NaN before learning, or from a layout-5
   // state, which judges every block as its build did).
   double max_learned_leverage() const { return max_learned_leverage_; }
+  // How often the learned range was extended to a new program since construction, reset or
+  // restore, and what the latest attempt found: the new blocks' own load slope and its standard
+  // error in m^3/(s Pa) (NaN before any attempt; diagnostics and tests, not saved).
+  struct RangeExtension {
+    std::size_t attempts = 0, extensions = 0;
+    double added_leak = kMissing, added_leak_error = kMissing;
+  };
+  RangeExtension range_extension() const { return range_extension_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
@@ -202,6 +224,7 @@ class FlowLawDetector final : public Detector {
   void reset_spool_time_constant();
   void set_chosen_flow(Block& b) const;
   void choose_spool_time_constant();
+  static double lag_load_share(std::span<const Block> blocks);
   void restart_block();
   void add_sample(double u, double x, double p1, double p2);
   void close_block(double t, bool past_settling);
@@ -235,6 +258,11 @@ class FlowLawDetector final : public Detector {
   double max_learned_leverage_ = kMissing;
   std::size_t outside_range_blocks_ = 0;
   bool outside_learned_range(const Block& b) const;
+  // The blocks outside the range gathered for its extension (reserved at construction).
+  std::vector<Block> outside_;
+  std::size_t extension_blocks_ = 0;  // range_extension_seconds in blocks (0: off)
+  RangeExtension range_extension_;
+  void extend_learned_range();
   bool waiting_ = false;
   Excitation excitation_;
   std::vector<double> rest_loads_;  // scratch, reserved as learned_

@@ -279,12 +279,16 @@ TEST(FlowLaw, AHoldThenASineIsNotLearnedBeforeTheStepsAndTheStepsRaiseNothing) {
   }
 }
 
-// Motion alone identifies the load term when the volumes leave most of its spread unexplained: a
-// triangle (share 0.99) is learned at the end of its learning period. A single fast sine's load
-// term is nearly a mix of the volumes (share 0.26-0.54): it keeps waiting, and a sweep after it
-// does not end the wait before the triangle that follows it does (a sweep's share is 0.6-0.86
-// in 30-90 s windows, docs/detection.md).
-TEST(FlowLaw, ATriangleIsLearnedAFastSineWaits) {
+// Motion identifies the load term when the volumes leave most of its spread unexplained: a
+// triangle (share 0.99) is learned at the end of its learning period. A fast sine's load term is
+// nearly a mix of the volumes (share 0.26-0.54; at 2.5 Hz a 0.2 s block is half a period and
+// the share is 0): asked to (`min_motion_load_share` 0.9) learning waits through it and through
+// a sweep after it (0.6-0.86 in 30-90 s windows) until the triangle ends the wait. By default
+// moving blocks are enough: the sine is learned where it runs and judged there (a leak in it
+// raises), and what the sine cannot tell about the load term is what the learned range keeps
+// from being judged elsewhere: the sweep and the triangle after it are not judged by the sine's
+// model until a range extension shows it describes them (docs/detection.md).
+TEST(FlowLaw, ATriangleIsLearnedByItsMotionAFastSineTooAndJudgedInItsOwnRange) {
   FlowLawOptions options;
   options.learning.learn_seconds = 30.0;
   sim::Phase triangle = phase(sim::PhaseKind::triangle, 0.0);
@@ -297,7 +301,7 @@ TEST(FlowLaw, ATriangleIsLearnedAFastSineWaits) {
     EXPECT_LT(o.learned_at, 33.0);  // at the end of the learning period
     EXPECT_FALSE(o.waited);
     EXPECT_EQ(detector.excitation().rest_loads, 0u);
-    EXPECT_GE(detector.excitation().motion_load_share, options.min_motion_load_share);
+    EXPECT_GE(detector.excitation().motion_load_share, 0.9);
     EXPECT_LT(o.max_score, detector.raise_threshold());
   }
   sim::Phase sine = phase(sim::PhaseKind::sine, 60.0);
@@ -309,19 +313,46 @@ TEST(FlowLaw, ATriangleIsLearnedAFastSineWaits) {
   sweep.A = 0.02;
   triangle.duration_s = 0.0;
   const capture::Capture capture = sim::simulate(program(43, {sine, sweep, triangle}, 180.0));
+  {
+    FlowLawOptions identifying = options;
+    identifying.min_motion_load_share = 0.9;
+    FlowLawDetector detector = make(identifying);
+    const Outcome in_sine = run(detector, capture, 1e9, 0, 60 * 500);
+    EXPECT_LT(in_sine.learned_at, 0.0);
+    EXPECT_TRUE(detector.waiting_for_excitation());
+    EXPECT_EQ(in_sine.last.not_judged_reason, NotJudgedReason::waiting_for_excitation);
+    EXPECT_LT(detector.excitation().motion_load_share, 0.9);
+    const Outcome later = run(detector, capture, 1e9, 60 * 500);
+    EXPECT_GT(later.learned_at, 90.0);  // in the triangle
+    EXPECT_FALSE(detector.waiting_for_excitation());
+    EXPECT_GE(detector.excitation().motion_load_share, 0.9);
+    EXPECT_LT(later.max_score, detector.raise_threshold());
+  }
   FlowLawDetector detector = make(options);
   const Outcome in_sine = run(detector, capture, 1e9, 0, 60 * 500);
-  EXPECT_LT(in_sine.learned_at, 0.0);
-  EXPECT_TRUE(detector.waiting_for_excitation());
-  EXPECT_EQ(in_sine.last.not_judged_reason, NotJudgedReason::waiting_for_excitation);
-  EXPECT_LT(detector.excitation().motion_load_share, options.min_motion_load_share);
+  EXPECT_GT(in_sine.learned_at, 0.0);
+  EXPECT_LT(in_sine.learned_at, 33.0);
+  EXPECT_FALSE(in_sine.waited);
+  EXPECT_LT(detector.excitation().motion_load_share, 0.9);
+  EXPECT_TRUE(in_sine.last.judged);
   const Outcome later = run(detector, capture, 1e9, 60 * 500);
-  std::printf("sine, sweep, triangle: learned at %.1f s, share %.3f\n", later.learned_at,
-              detector.excitation().motion_load_share);
-  EXPECT_GT(later.learned_at, 90.0);  // in the triangle
-  EXPECT_FALSE(detector.waiting_for_excitation());
-  EXPECT_GE(detector.excitation().motion_load_share, options.min_motion_load_share);
-  EXPECT_LT(later.max_score, detector.raise_threshold());
+  EXPECT_GT(detector.blocks_not_judged_outside_learned_range(), 0u);
+  EXPECT_LT(std::max(in_sine.max_score, later.max_score), detector.raise_threshold());
+  std::printf("sine, sweep, triangle: learned at %.1f s, share %.3f, %zu blocks outside\n",
+              in_sine.learned_at, detector.excitation().motion_load_share,
+              detector.blocks_not_judged_outside_learned_range());
+
+  sim::Scenario leaking = program(43, {sine, sweep, triangle}, 180.0);
+  sim::InternalLeakage leak;
+  leak.C_L = 1e-12;
+  leak.onset_s = 45.0;
+  leaking.effects.internal_leakage = leak;
+  FlowLawDetector judge = make(options);
+  const Outcome found = run(judge, sim::simulate(leaking), leak.onset_s);
+  EXPECT_LT(found.max_score, judge.raise_threshold());  // before the onset
+  EXPECT_GT(found.first_raise, leak.onset_s);
+  EXPECT_LT(found.first_raise, leak.onset_s + 15.0);  // in the sine
+  std::printf("leak in the sine from %.0f s: raised at %.2f s\n", leak.onset_s, found.first_raise);
 }
 
 // Run 7's program in short: a slow 6 s triangle of 35 mm (learned on), then a 0.46-2.5 Hz sweep
@@ -348,7 +379,9 @@ capture::Capture triangle_then_fast_sweep() {
 TEST(FlowLaw, AFastSweepBeyondWhatATriangleTaughtIsNotJudged) {
   const capture::Capture capture = triangle_then_fast_sweep();
   const std::size_t sweep_row = static_cast<std::size_t>(kTriangleSeconds * 500.0);
-  FlowLawDetector detector = make();
+  FlowLawOptions guarded;
+  guarded.range_extension_seconds = 0.0;  // the next test extends the range
+  FlowLawDetector detector = make(guarded);
   const Outcome in_triangle = run(detector, capture, 1e9, 0, sweep_row);
   EXPECT_GT(in_triangle.learned_at, 90.0);
   EXPECT_LT(in_triangle.learned_at, 150.0);
@@ -368,12 +401,142 @@ TEST(FlowLaw, AFastSweepBeyondWhatATriangleTaughtIsNotJudged) {
   EXPECT_EQ(in_sweep.last.not_judged_reason, NotJudgedReason::outside_learned_regime);
   EXPECT_LT(std::max(in_triangle.max_score, in_sweep.max_score), detector.raise_threshold());
 
-  FlowLawOptions unguarded;
+  FlowLawOptions unguarded = guarded;
   unguarded.max_leverage_ratio = 0.0;
   FlowLawDetector every_block = make(unguarded);
   const Outcome all = run(every_block, capture, 1e9);
   EXPECT_EQ(every_block.blocks_not_judged_outside_learned_range(), 0u);
   EXPECT_TRUE(all.last.judged);
+}
+
+// The same program, the range extended: gathered for 30 s, the sweep's blocks are fitted with the
+// triangle's normal equations, a load term of their own free in each half; healthy it comes out
+// at 1e-14 (+- 2e-14) against the floor's 2.5e-13, so the range is extended and the sweep judged
+// to its end without a raise. A 1e-12 leak opening 60 s into the sweep, after the extension, is
+// judged and raises. One opening 5 s into the sweep is in the new blocks' load term (1e-12): the
+// blocks cannot tell it from a model that does not describe the sweep, so nothing is learned
+// from them (a leak is never learned as healthy); it is raised by the sweep's blocks that lie
+// within the triangle's range (a sixth of them).
+TEST(FlowLaw, ASweepBeyondWhatATriangleTaughtIsLearnedWithoutLearningALeak) {
+  const auto with_leak_from = [](double onset) {
+    sim::Phase triangle = phase(sim::PhaseKind::triangle, kTriangleSeconds);
+    triangle.P = 6.0;
+    triangle.A = 0.035;
+    sim::Phase sweep = phase(sim::PhaseKind::sweep, 0.0);
+    sweep.F0 = 0.46;
+    sweep.F1 = 2.5;
+    sweep.A = 0.027;
+    sim::Scenario scenario = program(7, {triangle, sweep}, kTriangleSeconds + kSweepSeconds + 60.0);
+    if (onset > 0.0) {
+      sim::InternalLeakage leak;
+      leak.C_L = 1e-12;
+      leak.onset_s = onset;
+      scenario.effects.internal_leakage = leak;
+    }
+    return sim::simulate(scenario);
+  };
+  FlowLawDetector healthy = make();
+  std::uint64_t allocations = 0;
+  const Outcome quiet = run(healthy, with_leak_from(0.0), 1e9, 0, 0, &allocations);
+  EXPECT_EQ(allocations, 0u);  // gathering and refitting included
+  const FlowLawDetector::RangeExtension extension = healthy.range_extension();
+  EXPECT_GE(extension.extensions, 1u);
+  EXPECT_LT(std::abs(extension.added_leak), 1e-13);
+  EXPECT_LT(extension.added_leak_error, 1e-13);
+  EXPECT_TRUE(quiet.last.judged);
+  EXPECT_LT(quiet.max_score, healthy.raise_threshold());
+  std::printf("healthy: %zu extensions, added %.3g +- %.3g, %zu blocks outside\n",
+              extension.extensions, extension.added_leak, extension.added_leak_error,
+              healthy.blocks_not_judged_outside_learned_range());
+
+  constexpr double kLateOnset = kTriangleSeconds + 60.0;
+  FlowLawDetector detector = make();
+  const Outcome found = run(detector, with_leak_from(kLateOnset), kLateOnset);
+  EXPECT_LT(found.max_score, detector.raise_threshold());
+  EXPECT_GT(found.first_raise, kLateOnset);
+  EXPECT_LT(found.first_raise, kLateOnset + 60.0);
+  std::printf("leak from %.0f s: raised at %.2f s\n", kLateOnset, found.first_raise);
+
+  constexpr double kEarlyOnset = kTriangleSeconds + 5.0;
+  FlowLawDetector refusing = make();
+  const Outcome refused = run(refusing, with_leak_from(kEarlyOnset), kEarlyOnset);
+  EXPECT_GT(refused.first_raise, kEarlyOnset);
+  EXPECT_LT(refused.first_raise, kEarlyOnset + 60.0);
+  EXPECT_EQ(refusing.range_extension().extensions, 0u);
+  EXPECT_GE(refusing.range_extension().attempts, 2u);
+  EXPECT_NEAR(refusing.range_extension().added_leak, 1e-12, 0.2e-12);
+  std::printf("leak from %.0f s: raised at %.2f s, %zu attempts refused, added %.3g\n", kEarlyOnset,
+              refused.first_raise, refusing.range_extension().attempts,
+              refusing.range_extension().added_leak);
+
+  FlowLawOptions not_extended;
+  not_extended.range_extension_seconds = 0.0;
+  FlowLawDetector unextended = make(not_extended);
+  const Outcome missed = run(unextended, with_leak_from(kLateOnset), kLateOnset);
+  EXPECT_LT(missed.first_raise, 0.0);
+  EXPECT_EQ(unextended.range_extension().attempts, 0u);
+}
+
+// A 0.2 Hz sine, a 1.7 Hz sine, then steps (fault-tolerant controller). In the slow sine the
+// spool lag's flow follows the acceleration, -w^2 x, in phase with the spring's load: the other
+// regressors explain 96 % of the lag regressor, so the lag is not learned there (the stated
+// rung is kept; learned, the ladder chose 20 ms for 2.5 ms and the steps raised, score 1.17).
+// The fast sine and the steps are outside the slow sine's range until an extension shows that
+// the model describes them; nothing raises.
+TEST(FlowLaw, ASlowSineDoesNotTeachTheLagAndTheFasterProgramsAfterItRaiseNothing) {
+  sim::Phase slow = phase(sim::PhaseKind::sine, 300.0);
+  slow.F = 0.2;
+  slow.A = 0.03;
+  sim::Phase fast = phase(sim::PhaseKind::sine, 300.0);
+  fast.F = 1.7;
+  fast.A = 0.02;
+  const sim::Phase steps = phase(sim::PhaseKind::steps, 0.0);
+  for (const std::uint64_t seed : {7u, 2531u}) {
+    FlowLawDetector detector = make();
+    const Outcome o = run(detector, sim::simulate(program(seed, {slow, fast, steps}, 1000.0)), 1e9);
+    EXPECT_GT(o.learned_at, 0.0) << seed;
+    EXPECT_LT(o.learned_at, 300.0) << seed;  // in the slow sine
+    EXPECT_DOUBLE_EQ(detector.spool_time_constant(), sim::Parameters::nominal().tau) << seed;
+    EXPECT_GE(detector.range_extension().extensions, 1u) << seed;
+    EXPECT_GT(detector.blocks_not_judged_outside_learned_range(), 0u) << seed;
+    EXPECT_TRUE(o.last.judged) << seed;
+    EXPECT_LT(o.max_score, 0.5 * detector.raise_threshold()) << seed;
+  }
+}
+
+// Durability blocks of fast sines (2.79 Hz 25 mm, 2.52 Hz 9.5 mm), then steps: learned by their
+// motion at the end of the first learning period and judged in them; a 1e-12 leak opening in the
+// second sine raises within seconds. The steps are outside the sines' range; healthy, an
+// extension brings them in (their own load term -1.4e-13 to -1.9e-13, within the floor).
+TEST(FlowLaw, FastSinesAreLearnedAndJudgedAndALeakInThemRaises) {
+  sim::Phase first = phase(sim::PhaseKind::sine, 470.0);
+  first.F = 2.79;
+  first.A = 0.025;
+  sim::Phase second = phase(sim::PhaseKind::sine, 320.0);
+  second.F = 2.52;
+  second.A = 0.0095;
+  const sim::Phase steps = phase(sim::PhaseKind::steps, 0.0);
+  for (const std::uint64_t seed : {7u, 2531u}) {
+    const sim::Scenario healthy = program(seed, {first, second, steps}, 1100.0);
+    FlowLawDetector detector = make();
+    const Outcome o = run(detector, sim::simulate(healthy), 1e9);
+    EXPECT_GT(o.learned_at, 0.0) << seed;
+    EXPECT_LT(o.learned_at, 100.0) << seed;
+    EXPECT_GE(detector.range_extension().extensions, 1u) << seed;
+    EXPECT_TRUE(o.last.judged) << seed;
+    EXPECT_LT(o.max_score, 0.5 * detector.raise_threshold()) << seed;
+
+    sim::Scenario leaking = healthy;
+    sim::InternalLeakage leak;
+    leak.C_L = 1e-12;
+    leak.onset_s = 500.0;
+    leaking.effects.internal_leakage = leak;
+    FlowLawDetector judge = make();
+    const Outcome found = run(judge, sim::simulate(leaking), leak.onset_s);
+    EXPECT_LT(found.max_score, judge.raise_threshold()) << seed;
+    EXPECT_GT(found.first_raise, leak.onset_s) << seed;
+    EXPECT_LT(found.first_raise, leak.onset_s + 10.0) << seed;
+  }
 }
 
 // The paper's steps learned on the steps: hardly a block lies beyond the learned range.
@@ -571,6 +734,41 @@ TEST(FlowLaw, StateRoundTripDecidesTheSame) {
   other.block_seconds = 0.04;  // one hop per block: the saved block position does not fit
   FlowLawDetector wrong = make(other);
   EXPECT_THROW(wrong.import_state(saved), StateError);
+}
+
+// `leakmon evaluate --rigs other --seed 2951` run 17, not told its rig: a light (2.5 kg), stiff
+// rig whose valve lags 1.06 ms against the stated 2.5 ms. On its steps the volumes explain 93 %
+// of the lag regressor's spread, but the load term none of what they leave: the lag is told
+// apart from the load, so it is learned (kept at the stated rung, as when its whole share was
+// weighed, the 9.8e-13 leak was found 22 s late and cleared at once; learned, within 2 s).
+TEST(FlowLaw, ALagTheVolumesExplainButTheLoadDoesNotIsLearned) {
+  constexpr double kOnset = 142.0;
+  sim::Scenario s = program(295108870, {phase(sim::PhaseKind::steps, 0.0)}, 232.0);
+  s.params.D = 0.0543063;
+  s.params.d = 0.0235361;
+  s.params.L = 0.458499;
+  s.params.V_dead = 1.46439e-05;
+  s.params.V_line = 2.10465e-05;
+  s.params.ps = 2.3289e+07;
+  s.params.pt = 656130.0;
+  s.params.beta = 1.31365e+09;
+  s.params.m = 2.499;
+  s.params.b = 945.226;
+  s.params.K_s = 141494.0;
+  s.params.Kv = 3.31031e-07;
+  s.params.tau = 0.001059;
+  s.effects.internal_leakage = sim::InternalLeakage{9.76494e-13, kOnset, 0.0};
+  const capture::Capture capture = sim::simulate(s);
+  FlowLawDetector detector = make();  // not told: the paper's rig
+  const Outcome o = run(detector, capture, kOnset);
+  EXPECT_GT(o.learned_at, 0.0);
+  EXPECT_NE(detector.spool_time_constant(), FlowLawOptions{}.rig.tau);
+  EXPECT_LT(detector.spool_time_constant(), 0.0025);
+  EXPECT_LT(o.max_score, detector.raise_threshold());
+  EXPECT_GT(o.first_raise, kOnset);
+  EXPECT_LT(o.first_raise, kOnset + 10.0);
+  std::printf("lag learned %.2f ms, raised %.1f s after the onset\n",
+              1e3 * detector.spool_time_constant(), o.first_raise - kOnset);
 }
 
 // A valve slower than the stated one (12 ms against the table's 2.5 ms, within MODEL.md's
