@@ -584,24 +584,21 @@ void FlowLawDetector::judge(const Block& b) {
 // the regressors it was learned on (docs/detection.md).
 bool FlowLawDetector::outside_learned_range(const Block& b) const {
   if (!(options_.max_leverage_ratio > 0.0) || !(max_learned_leverage_ > 0.0)) return false;
-  Coefficients x = regressors(b);
-  // A regressor left out of the fit was a zero column while learning (its coefficient 0): the
-  // range has no extent along it and it does not count.
-  if (!fit_null_offset_) x[5] = 0.0;
+  const Coefficients x = fitted_regressors(b);
   return x.dot(inverse_normal_ * x) > options_.max_leverage_ratio * max_learned_leverage_;
 }
 
 // A model learned on a slow triangle does not judge a fast sweep after it (its spool-lag term is
 // extrapolated there); a rig's program changes within a shift. The learned blocks are gone, but
 // their normal equations are not: X'X is the inverse of the kept (X'X)^-1 and X'y = X'X c. The
-// gathered blocks outside the range join them with one more regressor, their own load term g
-// (zero on the learned blocks): every coefficient the new program shares with the old is refitted
-// on both (the lag's above all), and whatever the new blocks do along the load that the shared
-// model does not, a leak that opened with the new program or the model's bias there, goes to g
-// and not to the cross-port term. Extended only when g is told apart within `min_leak` and is
-// smaller than it: judged from then on with the shared coefficients, a leak in the new program
-// still shows in full. Otherwise nothing is learned (a leak is never learned as healthy) and the
-// oldest half of the gathered blocks makes room for the next.
+// gathered blocks outside the range join them with a load term of their own for each half of
+// them (zero on the learned blocks): every coefficient the new program shares with the old is
+// refitted on both (the lag's above all), and whatever the new blocks do along the load that the
+// shared model does not, a leak that opened with the new program or the model's bias there, goes
+// to those terms and not to the cross-port term. Extended only when each term lies within
+// `min_leak` by two standard errors: judged from then on with the shared coefficients, a leak in
+// the new program still shows in full. Otherwise nothing is learned (a leak is never learned as
+// healthy) and the oldest half of the gathered blocks makes room for the next.
 void FlowLawDetector::extend_learned_range() {
   // The learned regressors, then the load term of the gathered blocks' older half and of their
   // newer half, each zero elsewhere.
@@ -612,8 +609,7 @@ void FlowLawDetector::extend_learned_range() {
   const auto regressors_of = [this, half](std::size_t i) {
     const Block& b = outside_[i];
     Vector x;
-    x << regressors(b), i < half ? b.load : 0.0, i < half ? 0.0 : b.load;
-    if (!fit_null_offset_) x[5] = 0.0;
+    x << fitted_regressors(b), i < half ? b.load : 0.0, i < half ? 0.0 : b.load;
     return x;
   };
   ++range_extension_.attempts;
@@ -663,8 +659,7 @@ void FlowLawDetector::extend_learned_range() {
   for (int k = kRegressors; k < kAll; ++k) {
     const double added = fitted[k] / a;  // in the load regressor's slope units
     const double added_error = sigma * std::sqrt(std::max(inverse(k, k), 0.0)) / std::abs(a);
-    describes = describes && 2.0 * added_error < floor_slope_ &&
-                std::abs(added) + 2.0 * added_error < floor_slope_;
+    describes = describes && std::abs(added) + 2.0 * added_error < floor_slope_;
     if (!(std::abs(added * to_leak) <= std::abs(range_extension_.added_leak))) {
       range_extension_.added_leak = added * to_leak;
       range_extension_.added_leak_error = added_error * to_leak;
@@ -683,8 +678,7 @@ void FlowLawDetector::extend_learned_range() {
       shared_normal.ldlt().solve(Eigen::Matrix<double, kRegressors, kRegressors>::Identity());
   // A learned block's leverage can only fall with more blocks: the old largest bounds them.
   for (const auto& b : outside_) {
-    Coefficients x = regressors(b);
-    if (!fit_null_offset_) x[5] = 0.0;
+    const Coefficients x = fitted_regressors(b);
     max_learned_leverage_ = std::max(max_learned_leverage_, x.dot(inverse_normal_ * x));
   }
   block_sigma_ = sigma;

@@ -214,6 +214,13 @@ class FlowLawDetector final : public Detector {
     r << b.move, b.load, b.comp, b.length, b.lag, b.null_offset;
     return r;
   }
+  // The regressors as the model was fitted on them: a regressor left out of the fit was a zero
+  // column while learning (its coefficient 0), so the range has no extent along it.
+  Coefficients fitted_regressors(const Block& b) const {
+    Coefficients r = regressors(b);
+    if (!fit_null_offset_) r[5] = 0.0;
+    return r;
+  }
   double residual(const Block& b) const { return b.y - coefficients_.dot(regressors(b)); }
 
   // The rungs of the ladder integrated, first to last.
