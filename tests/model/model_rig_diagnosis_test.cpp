@@ -108,15 +108,28 @@ TEST(OtherRig, MisstatedSupplyIsARigParameterNotASensorOffset) {
                  "assert set(r['calibrated'])=={'beta','Kv','m','b'}");
 }
 
-// A load stiffness stated 40-80 % off: `rig_parameter` load_stiffness, fitted within 10 %.
+// A load stiffness stated 40-80 % off: `rig_parameter` load_stiffness, named first and fitted
+// within 10 %, on every draw (the evaluations: every mis-stated value found and fitted). Named
+// *alone* on about nine draws in ten (docs/model-check.md: 31 of 36, 16 of 18, 11 of 11): the
+// misses carry a second, small library effect where the true model itself stays above the
+// estimated noise floor (seed 15528031207838567108: coulomb_friction 11 N, the true model
+// 0.0222 against a floor of 0.0126). So per run, four draws: alone on at least two (a run fails
+// by chance about once in 300 at that rate).
 TEST(OtherRig, MisstatedLoadStiffnessIsARigParameter) {
-  const auto seed = test::model_test_seed("OtherRig.MisstatedLoadStiffnessIsARigParameter");
-  const SyntheticCase c = draw_case(seed, "none", other_rig(90.0, "load_stiffness"));
-  const Diagnosis d = diagnose_case(c);
-  ASSERT_EQ(d.cause, "rig_parameter");
-  ASSERT_EQ(d.causes.size(), 1u) << causes(d);
-  EXPECT_EQ(d.causes.front().params[0].text, "load_stiffness");
-  EXPECT_NEAR(d.causes.front().params[2].value, c.misstated_true, 0.1 * c.misstated_true);
+  const auto first =
+      test::model_test_seed("OtherRig.MisstatedLoadStiffnessIsARigParameter (first of 4)");
+  int alone = 0;
+  for (std::uint64_t i = 0; i < 4; ++i) {
+    const SyntheticCase c = draw_case(first + i, "none", other_rig(90.0, "load_stiffness"));
+    const Diagnosis d = diagnose_case(c);
+    ASSERT_EQ(d.cause, "rig_parameter") << "seed " << first + i;
+    ASSERT_FALSE(d.causes.empty());
+    EXPECT_EQ(d.causes.front().params[0].text, "load_stiffness") << "seed " << first + i;
+    EXPECT_NEAR(d.causes.front().params[2].value, c.misstated_true, 0.1 * c.misstated_true)
+        << "seed " << first + i;
+    alone += d.causes.size() == 1;
+  }
+  EXPECT_GE(alone, 2) << "load stiffness named alone, of 4";
 }
 
 // The capture: a leak opening inside a capture of the paper's rig at constant
