@@ -95,6 +95,7 @@ void FlowLawDetector::reset() {
   coefficients_.setZero();
   block_sigma_ = kMissing;
   waiting_ = false;
+  learning_restarts_ = 0;
   excitation_ = Excitation{};
   no_load_blocks_ = 0;
   inverse_normal_.setZero();
@@ -284,12 +285,37 @@ void FlowLawDetector::close_block(double t, bool past_settling) {
 }
 
 void FlowLawDetector::learn(const Block& b) {
+  if (waiting_ && b.moving != 0.0 && resumes_after_hold()) restart_learning_on_motion();
   if (learned_.size() == learn_capacity_) learned_.erase(learned_.begin());
   learned_.push_back(b);
   if (!fit_null_offset_) learned_.back().null_offset = 0.0;  // a zero column: coefficient 0
   if (!clock_.period_over()) return;
   waiting_ = !identified();
   if (!waiting_) finish_learning();
+}
+
+// Waiting, the newest block at rest and most of the window too: a hold the rig now leaves.
+bool FlowLawDetector::resumes_after_hold() const {
+  if (learned_.empty() || learned_.back().moving != 0.0) return false;
+  const auto moving = std::count_if(learned_.begin(), learned_.end(),
+                                    [](const Block& b) { return b.moving != 0.0; });
+  return static_cast<double>(moving) < kHoldMotionShare * static_cast<double>(learned_.size());
+}
+
+// A rig that holds still for minutes and then moves would otherwise learn on a window that is
+// mostly the hold: the motion ends the wait within its first seconds, the leak check of the
+// learning period (probe_learned_change) finds no reference that identifies the load term in
+// the hold, and a leak opening in that motion is learned as healthy (issue 23: seed 3307 run
+// 32, a leak 35 s into a triangle after a 316 s hold, never raised). So the period starts over
+// with the motion, as a start in motion would, keeping the hold's newest seconds: its load is
+// then within the learned range.
+void FlowLawDetector::restart_learning_on_motion() {
+  const std::size_t keep =
+      std::min(learned_.size(), hops_in(kHoldSecondsKept, options_.block_seconds));
+  learned_.erase(learned_.begin(), learned_.end() - static_cast<std::ptrdiff_t>(keep));
+  clock_.restart_period();
+  waiting_ = false;
+  ++learning_restarts_;
 }
 
 bool FlowLawDetector::identified() {

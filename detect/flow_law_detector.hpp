@@ -148,6 +148,9 @@ class FlowLawDetector final : public Detector {
     double added_leak = kMissing, added_leak_error = kMissing;
   };
   RangeExtension range_extension() const { return range_extension_; }
+  // How often motion resuming after a wait at rest started the learning period over since
+  // construction, reset or restore (diagnostics and tests; not saved).
+  std::size_t learning_restarts() const { return learning_restarts_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
@@ -168,6 +171,10 @@ class FlowLawDetector final : public Detector {
   // A rest load counts once this many blocks at rest lie at it (a second): the first steps after
   // a long other program do not end learning on a window that is mostly that program.
   static constexpr std::size_t kRestLoadBlocks = 5;
+  // Motion resuming after a wait whose window moved in under this share of its blocks starts the
+  // learning period over (restart_learning_on_motion), keeping the hold's newest seconds.
+  static constexpr double kHoldMotionShare = 0.25;
+  static constexpr double kHoldSecondsKept = 5.0;
   // What the latest check of the learning blocks found since construction, reset or restore
   // (diagnostics and tests; not saved): the distinct loads at rest and the motion's share of the
   // load term (NaN: under kMotionBlockShare moving, or too few).
@@ -240,6 +247,8 @@ class FlowLawDetector final : public Detector {
   // Whether the learning blocks identify the model (excited, and the rest loads or the motion of
   // min_rest_loads); sets excitation_. Uses rest_loads_.
   bool identified();
+  bool resumes_after_hold() const;
+  void restart_learning_on_motion();
   double motion_load_share(std::span<const Block> blocks) const;
   void probe_learned_change();
   void finish_learning();
@@ -271,6 +280,7 @@ class FlowLawDetector final : public Detector {
   RangeExtension range_extension_;
   void extend_learned_range();
   bool waiting_ = false;
+  std::size_t learning_restarts_ = 0;
   Excitation excitation_;
   std::vector<double> rest_loads_;  // scratch, reserved as learned_
   std::size_t no_load_blocks_ = 0;

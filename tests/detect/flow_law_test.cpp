@@ -240,49 +240,38 @@ TEST(FlowLaw, HoldOnlyStartWaitsForExcitation) {
 
 // Issue 23: a program that starts with a hold and runs a slow sine before its steps. By the
 // spread of its loads alone (min_rest_loads 0, the build before the wait for rest loads or
-// identifying motion) the detector learned 22 s into the sine, from the hold and the sine, and
-// the steps raised internal_leakage on a healthy rig. Now it waits through the hold and the
-// sine (one load at rest, three quarters of the blocks never moving), learns on the steps'
-// rests and raises nothing. Two draws.
-TEST(FlowLaw, AHoldThenASineIsNotLearnedBeforeTheStepsAndTheStepsRaiseNothing) {
+// identifying motion) the detector learned 22 s into the sine, on a window mostly the hold, and
+// the steps raised internal_leakage on a healthy rig. Then it waited through the hold and the
+// sine (a window three quarters hold) and learned on the steps. Now the sine's motion starts
+// the learning period over and it is learned on the sine alone, 90 s into it; the steps after
+// it lie almost all within what the sine taught (29 and 39 of their 600 blocks outside), are
+// judged, and raise nothing. Two draws.
+TEST(FlowLaw, AHoldThenASineIsLearnedOnTheSineAndTheStepsAfterRaiseNothing) {
   std::vector<sim::Phase> phases = {phase(sim::PhaseKind::hold, 100.0),
                                     phase(sim::PhaseKind::sine, 100.0),
                                     phase(sim::PhaseKind::steps, 0.0)};
   phases[0].X = 0.02;
   phases[1].F = 0.2;
   phases[1].A = 0.03;
-  constexpr double kStepsStart = 200.0;
+  constexpr double kSineStart = 100.0, kStepsStart = 200.0;
+  const double learn_seconds = FlowLawOptions{}.learning.learn_seconds;
   const std::size_t steps_row = static_cast<std::size_t>(kStepsStart * 500.0);
   for (const std::uint64_t seed : {2531u, 7u}) {
     const capture::Capture capture = sim::simulate(program(seed, phases, 320.0));
     FlowLawDetector detector = make();
     const Outcome before = run(detector, capture, 1e9, 0, steps_row);
-    EXPECT_LT(before.learned_at, 0.0) << seed;
-    EXPECT_TRUE(detector.waiting_for_excitation()) << seed;
-    EXPECT_TRUE(before.last.learning) << seed;
-    EXPECT_EQ(before.last.not_judged_reason, NotJudgedReason::waiting_for_excitation) << seed;
-    EXPECT_LT(detector.excitation().rest_loads, 3u) << seed;
+    EXPECT_TRUE(before.waited) << seed;  // through the hold
+    EXPECT_EQ(detector.learning_restarts(), 1u) << seed;
+    EXPECT_GT(before.learned_at, kSineStart + learn_seconds - 1.0) << seed;
+    EXPECT_LT(before.learned_at, kStepsStart) << seed;
+    EXPECT_LT(before.max_score, detector.raise_threshold()) << seed;
     const Outcome steps = run(detector, capture, 1e9, steps_row);
-    EXPECT_GT(steps.learned_at, kStepsStart) << seed;
-    EXPECT_GE(detector.excitation().rest_loads, 3u) << seed;
+    std::printf("seed %llu: learned at %.1f, steps' max score %.3f, blocks outside %zu\n",
+                static_cast<unsigned long long>(seed), before.learned_at, steps.max_score,
+                detector.blocks_not_judged_outside_learned_range());
     EXPECT_LT(steps.max_score, detector.raise_threshold()) << seed;
+    EXPECT_LT(detector.blocks_not_judged_outside_learned_range(), 120u) << seed;
     EXPECT_TRUE(steps.last.judged) << seed;
-
-    // The build before the wait (and before the learned range) raised in the steps.
-    FlowLawOptions spread_alone;
-    spread_alone.min_rest_loads = 0.0;
-    spread_alone.max_leverage_ratio = 0.0;
-    FlowLawDetector old_rule = make(spread_alone);
-    const Outcome o = run(old_rule, capture, 1e9);
-    EXPECT_LT(o.learned_at, kStepsStart) << seed;
-    EXPECT_GE(o.max_score, old_rule.raise_threshold()) << seed;
-    // Learned on the hold and the sine, the learned range alone keeps the steps from being
-    // judged by that model.
-    spread_alone.max_leverage_ratio = FlowLawOptions{}.max_leverage_ratio;
-    FlowLawDetector ranged = make(spread_alone);
-    const Outcome r = run(ranged, capture, 1e9);
-    EXPECT_LT(r.max_score, ranged.raise_threshold()) << seed;
-    EXPECT_GT(ranged.blocks_not_judged_outside_learned_range(), 0u) << seed;
   }
 }
 
@@ -673,6 +662,46 @@ TEST(FlowLaw, ALeakOpeningWhileLearningIsReported) {
   EXPECT_NEAR(change->change_t, kOnset, 3.0);
   EXPECT_GT(change->size, 1e-12);
   EXPECT_LT(change->size, 4e-12);
+}
+
+// A rig that holds still for minutes, then runs a triangle in which a leak opens 35 s in (run
+// 32 of `evaluate --conditions programs --seed 3307`: a 316 s hold, a leak 35 s into a 2.2 s
+// triangle, not reported in the 90 s the run lasted after it). The wait ended only when a
+// quarter of the 180 s window had moved away from the hold's load, here 135 s into the triangle
+// (100 s after the onset), and on a window a third of which was the hold. Now the motion starts
+// the learning period over: learned 90 s into the triangle, the learning period's leak check
+// (its reference the triangle's first 36 s) reports the leak with its onset 55 s after it
+// opened. The healthy run: learned once, nothing reported, nothing raised after.
+TEST(FlowLaw, ALeakOpeningInTheFirstMotionAfterALongHoldIsReported) {
+  constexpr double kHoldSeconds = 200.0;
+  constexpr double kOnset = kHoldSeconds + 35.0;
+  std::vector<sim::Phase> phases = {phase(sim::PhaseKind::hold, kHoldSeconds),
+                                    phase(sim::PhaseKind::triangle, 0.0)};
+  phases[0].X = 0.03;
+  phases[1].P = 2.2;
+  phases[1].A = 0.02;
+  const sim::Scenario healthy = program(32, phases, kHoldSeconds + 150.0);
+  sim::Scenario leaking = healthy;
+  leaking.effects.internal_leakage = sim::InternalLeakage{1e-12, kOnset, 0.0};
+
+  FlowLawDetector clean = make();
+  const Outcome h = run(clean, sim::simulate(healthy), 1e9);
+  EXPECT_EQ(clean.learning_restarts(), 1u);
+  EXPECT_GT(h.learned_at, kHoldSeconds + FlowLawOptions{}.learning.learn_seconds);
+  EXPECT_FALSE(clean.learned_change().has_value());
+  EXPECT_LT(h.max_score, clean.raise_threshold());
+  EXPECT_TRUE(h.last.judged);
+
+  FlowLawDetector detector = make();
+  const Outcome l = run(detector, sim::simulate(leaking), 1e9);
+  EXPECT_EQ(detector.learning_restarts(), 1u);
+  ASSERT_FALSE(l.last.learning);
+  const auto change = detector.learned_change();
+  EXPECT_LT(l.learned_at, kOnset + 60.0);  // reported when learning ends: within a minute
+  ASSERT_TRUE(change.has_value());
+  EXPECT_NEAR(change->change_t, kOnset, 3.0);
+  EXPECT_GT(change->size, 0.5e-12);
+  EXPECT_LT(change->size, 2e-12);
 }
 
 // The daemon holds the detector while a channel is faulty (no update at all): the first block
