@@ -407,6 +407,17 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                  },
                  0.0, 0.0,
                  [](O& o) { return std::string(o.learn_null_offset ? "true" : "false"); }),
+             other_option<O>(
+                 "learn_before_change", "", "true, false",
+                 "a leak that opened while learning: learn on the blocks before it and judge "
+                 "those after it (raised); false: learn on all and report it",
+                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
+                   if (node != nullptr) {
+                     o.learn_before_change = node->get_bool(row.key, o.learn_before_change);
+                   }
+                 },
+                 0.0, 0.0,
+                 [](O& o) { return std::string(o.learn_before_change ? "true" : "false"); }),
              number_option<O>("min_load_spread", 0.0, 1e9,
                               "learning waits until the learning blocks' mean loads p1 - p2 "
                               "spread this much (std) [Pa]",

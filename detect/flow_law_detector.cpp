@@ -96,6 +96,7 @@ void FlowLawDetector::reset() {
   block_sigma_ = kMissing;
   waiting_ = false;
   learning_restarts_ = 0;
+  changes_judged_after_learning_ = 0;
   excitation_ = Excitation{};
   no_load_blocks_ = 0;
   inverse_normal_.setZero();
@@ -522,18 +523,49 @@ double FlowLawDetector::spool_time_constant() const {
 
 void FlowLawDetector::finish_learning() {
   choose_spool_time_constant();
+  probe_learned_change();
+  // A leak that opened while learning, after a reference that identifies the model: the blocks
+  // before it are a healthy rig's, so the model is learned on them and the blocks after it are
+  // judged as they would have been had learning ended before it (the CUSUM raises on them), not
+  // learned as healthy and merely reported.
+  std::span<const Block> healthy(learned_);
+  std::span<const Block> after_change;
+  if (learned_change_ && options_.learn_before_change) {
+    const double change_t = learned_change_->change_t;
+    const auto first_after = std::find_if(learned_.begin(), learned_.end(),
+                                          [change_t](const Block& b) { return b.t > change_t; });
+    const std::span<const Block> before(learned_.data(),
+                                        static_cast<std::size_t>(first_after - learned_.begin()));
+    if (excited(before)) {
+      healthy = before;
+      after_change = std::span<const Block>(learned_).subspan(before.size());
+    }
+  }
+  fit_healthy(healthy);
+  clock_.set_learned();
+  if (!after_change.empty()) {
+    learned_change_.reset();
+    ++changes_judged_after_learning_;
+    for (const auto& b : after_change) judge(b);
+  }
+  learned_.clear();
+}
+
+// The model, its learned range, the block spread and the drift reference's start from blocks of
+// a healthy rig.
+void FlowLawDetector::fit_healthy(std::span<const Block> blocks) {
   LeastSquares<kRegressors> fit;
-  for (const auto& b : learned_) fit.add(regressors(b), b.y);
+  for (const auto& b : blocks) fit.add(regressors(b), b.y);
   coefficients_ = fit.solve();
   inverse_normal_ = fit.inverse_normal();
   max_learned_leverage_ = 0.0;
-  for (const auto& b : learned_) {
+  for (const auto& b : blocks) {
     const Coefficients x = regressors(b);
     max_learned_leverage_ = std::max(max_learned_leverage_, x.dot(inverse_normal_ * x));
   }
   double sum_sq = 0.0, sum_lag = 0.0, previous = 0.0;
   double previous_t = kMissing;
-  for (const auto& b : learned_) {
+  for (const auto& b : blocks) {
     const double r = residual(b);
     sum_sq += r * r;
     // Neighbours only (the next block after the previous one).
@@ -544,13 +576,10 @@ void FlowLawDetector::finish_learning() {
     previous_t = b.t;
     drift_.add(b.t, r, b.load);
   }
-  const std::size_t blocks = learned_.size();
-  const double dof = static_cast<double>(blocks > 4 ? blocks - 4 : 1);
-  block_sigma_ = cusum_block_sigma(std::sqrt(sum_sq / dof), blocks,
+  const std::size_t count = blocks.size();
+  const double dof = static_cast<double>(count > 4 ? count - 4 : 1);
+  block_sigma_ = cusum_block_sigma(std::sqrt(sum_sq / dof), count,
                                    sum_sq > 0.0 ? lag_one_correlation(sum_lag, sum_sq) : 0.0);
-  probe_learned_change();
-  clock_.set_learned();
-  learned_.clear();
 }
 
 void FlowLawDetector::judge(const Block& b) {

@@ -106,6 +106,10 @@ struct FlowLawOptions {
   // from the others within `min_leak` and lies within it; else the oldest half is dropped and
   // the next ones gathered (docs/detection.md). 0: never extended (the build before).
   double range_extension_seconds = 30.0;
+  // A leak that opened while learning, after a reference that identifies the model
+  // (learned_change.hpp): learn on the blocks before it and judge those after it, so that it
+  // raises internal_leakage. false: learn on every block and only report it (learned_change).
+  bool learn_before_change = true;
   // A decision counts as judged while a block was judged within this time [s] (status, metrics).
   double judged_memory_seconds = 10.0;
 };
@@ -151,6 +155,9 @@ class FlowLawDetector final : public Detector {
   // How often motion resuming after a wait at rest started the learning period over since
   // construction, reset or restore (diagnostics and tests; not saved).
   std::size_t learning_restarts() const { return learning_restarts_; }
+  // How often a leak that opened while learning was left out of the learning and judged
+  // (learn_before_change) since construction, reset or restore (diagnostics; not saved).
+  std::size_t changes_judged_after_learning() const { return changes_judged_after_learning_; }
   // The spool time constant the flow is integrated with: learned (or rig.tau when not learned
   // from the data); NaN while learning still weighs the ladder.
   double spool_time_constant() const;
@@ -252,6 +259,7 @@ class FlowLawDetector final : public Detector {
   double motion_load_share(std::span<const Block> blocks) const;
   void probe_learned_change();
   void finish_learning();
+  void fit_healthy(std::span<const Block> blocks);
   void judge(const Block& b);
   Decision decide() const;
 
@@ -281,6 +289,7 @@ class FlowLawDetector final : public Detector {
   void extend_learned_range();
   bool waiting_ = false;
   std::size_t learning_restarts_ = 0;
+  std::size_t changes_judged_after_learning_ = 0;
   Excitation excitation_;
   std::vector<double> rest_loads_;  // scratch, reserved as learned_
   std::size_t no_load_blocks_ = 0;

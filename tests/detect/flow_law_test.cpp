@@ -641,22 +641,40 @@ TEST(FlowLaw, JudgedMemoryIsConfigured) {
   EXPECT_EQ(forgotten.last.not_judged_reason, NotJudgedReason::no_load);
 }
 
-// A leak that opens while learning is learned as healthy; the probe says so once learning ends,
-// near its onset and sized as a leak. The same run without the leak says nothing.
-TEST(FlowLaw, ALeakOpeningWhileLearningIsReported) {
+// A leak opening while learning, after a reference that identifies the model: learned on the
+// blocks before it and the blocks after it judged, so it raises internal_leakage when learning
+// ends, sized within a quarter; nothing is left to report as learned. With
+// learn_before_change false (the build before) it is learned as healthy and only reported
+// (learned_change) with its onset. The healthy run does neither.
+TEST(FlowLaw, ALeakOpeningWhileLearningIsRaisedWhenLearningEnds) {
   const std::vector<sim::Phase> phases = {phase(sim::PhaseKind::steps, 0.0)};
   sim::Scenario healthy = program(11, phases, 110.0);
   sim::Scenario leaking = healthy;
   constexpr double kOnset = 65.0;
   leaking.effects.internal_leakage = sim::InternalLeakage{2e-12, kOnset, 0.0};
+  const capture::Capture leaky = sim::simulate(leaking);
   FlowLawDetector clean = make();
   const Outcome h = run(clean, sim::simulate(healthy), 1e9);
   ASSERT_FALSE(h.last.learning);
   EXPECT_FALSE(clean.learned_change().has_value());
+  EXPECT_EQ(clean.changes_judged_after_learning(), 0u);
+  EXPECT_LT(h.max_score, clean.raise_threshold());
+
   FlowLawDetector detector = make();
-  const Outcome l = run(detector, sim::simulate(leaking), 1e9);
+  const Outcome l = run(detector, leaky, kOnset);
   ASSERT_FALSE(l.last.learning);
-  const auto change = detector.learned_change();
+  EXPECT_EQ(detector.changes_judged_after_learning(), 1u);
+  EXPECT_FALSE(detector.learned_change().has_value());
+  ASSERT_GT(l.first_raise, 0.0);
+  EXPECT_LT(l.first_raise, l.learned_at + 1.0);  // on the blocks judged when learning ends
+  EXPECT_NEAR(l.at_raise.leak_coefficient, 2e-12, 0.5e-12);
+
+  FlowLawOptions report_only;
+  report_only.learn_before_change = false;
+  FlowLawDetector old = make(report_only);
+  const Outcome o = run(old, leaky, kOnset);
+  EXPECT_LT(o.first_raise, 0.0);
+  const auto change = old.learned_change();
   ASSERT_TRUE(change.has_value());
   EXPECT_EQ(change->feature, "flow_residual");
   EXPECT_NEAR(change->change_t, kOnset, 3.0);
@@ -666,13 +684,14 @@ TEST(FlowLaw, ALeakOpeningWhileLearningIsReported) {
 
 // A rig that holds still for minutes, then runs a triangle in which a leak opens 35 s in (run
 // 32 of `evaluate --conditions programs --seed 3307`: a 316 s hold, a leak 35 s into a 2.2 s
-// triangle, not reported in the 90 s the run lasted after it). The wait ended only when a
-// quarter of the 180 s window had moved away from the hold's load, here 135 s into the triangle
-// (100 s after the onset), and on a window a third of which was the hold. Now the motion starts
-// the learning period over: learned 90 s into the triangle, the learning period's leak check
-// (its reference the triangle's first 36 s) reports the leak with its onset 55 s after it
-// opened. The healthy run: learned once, nothing reported, nothing raised after.
-TEST(FlowLaw, ALeakOpeningInTheFirstMotionAfterALongHoldIsReported) {
+// triangle, not found in the 90 s the run lasted after it). The wait ended only when a quarter
+// of the 180 s window had moved away from the hold's load, here 135 s into the triangle (100 s
+// after the onset), on a window a third of which was the hold, and the leak was learned as
+// healthy. Now the motion starts the learning period over: 90 s into the triangle the learning
+// period's leak check (its reference the triangle's first 36 s) finds the leak, the model is
+// learned on the blocks before it and it raises then, 55 s after it opened. The healthy run:
+// learned once, nothing raised.
+TEST(FlowLaw, ALeakOpeningInTheFirstMotionAfterALongHoldIsRaisedWithinAMinute) {
   constexpr double kHoldSeconds = 200.0;
   constexpr double kOnset = kHoldSeconds + 35.0;
   std::vector<sim::Phase> phases = {phase(sim::PhaseKind::hold, kHoldSeconds),
@@ -688,20 +707,16 @@ TEST(FlowLaw, ALeakOpeningInTheFirstMotionAfterALongHoldIsReported) {
   const Outcome h = run(clean, sim::simulate(healthy), 1e9);
   EXPECT_EQ(clean.learning_restarts(), 1u);
   EXPECT_GT(h.learned_at, kHoldSeconds + FlowLawOptions{}.learning.learn_seconds);
-  EXPECT_FALSE(clean.learned_change().has_value());
   EXPECT_LT(h.max_score, clean.raise_threshold());
   EXPECT_TRUE(h.last.judged);
 
   FlowLawDetector detector = make();
-  const Outcome l = run(detector, sim::simulate(leaking), 1e9);
+  const Outcome l = run(detector, sim::simulate(leaking), kOnset);
   EXPECT_EQ(detector.learning_restarts(), 1u);
-  ASSERT_FALSE(l.last.learning);
-  const auto change = detector.learned_change();
-  EXPECT_LT(l.learned_at, kOnset + 60.0);  // reported when learning ends: within a minute
-  ASSERT_TRUE(change.has_value());
-  EXPECT_NEAR(change->change_t, kOnset, 3.0);
-  EXPECT_GT(change->size, 0.5e-12);
-  EXPECT_LT(change->size, 2e-12);
+  EXPECT_EQ(detector.changes_judged_after_learning(), 1u);
+  ASSERT_GT(l.first_raise, 0.0);
+  EXPECT_LT(l.first_raise, kOnset + 60.0);
+  EXPECT_NEAR(l.at_raise.leak_coefficient, 1e-12, 0.3e-12);
 }
 
 // The daemon holds the detector while a channel is faulty (no update at all): the first block

@@ -1,9 +1,10 @@
 // A leak that opens while the detector learns (detect/learned_change.hpp), through the daemon's
 // own pipeline with the built-in defaults: replay_capture of a 120 s capture whose leak opens at
-// 70 s, inside the 92 s of learning, writes `learned_change` near the onset, both with u and x
-// (the flow balance's command residual) and with p1 and p2 only (the index). Healthy captures
-// that drift while learning (MODEL.md "Drifting operating conditions": a cold start, a cooler
-// cycle, a supply change) write none.
+// 70 s, inside the 92 s of learning. With u and x the default (flow_law) learns on the blocks
+// before the leak and raises it when learning ends; told not to (`learn_before_change: false`)
+// it writes `learned_change` near the onset, as the pressure-only detectors do (the index).
+// Healthy captures that drift while learning (MODEL.md "Drifting operating conditions": a cold
+// start, a cooler cycle, a supply change) write neither.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "config/yaml_reader.hpp"
 #include "pipeline/event_log.hpp"
 #include "pipeline/replay.hpp"
 #include "sim/simulate.hpp"
@@ -40,10 +42,39 @@ ReplayResult replay(const capture::Capture& capture) {
   return replay_capture(capture, default_replay_config(capture));
 }
 
-TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
+std::vector<io::Event> leak_alarms(const ReplayResult& result) {
+  std::vector<io::Event> out;
+  std::copy_if(result.events.begin(), result.events.end(), std::back_inserter(out),
+               [](const io::Event& e) {
+                 return e.kind == io::EventKind::alarm_raised && e.alarm == "internal_leakage";
+               });
+  return out;
+}
+
+// The default with u and x learns on the 68 s before the leak and judges the rest: the leak is
+// raised when learning ends (92 s), sized, and not also reported as learned.
+TEST(LearnedChange, ALeakOpeningDuringLearningIsRaisedWhenLearningEnds) {
   const capture::Capture full = with_leak_in_learning(7, 2e-12);
   const ReplayResult flow = replay(full);
-  const auto found = learned_changes(flow);
+  EXPECT_TRUE(learned_changes(flow).empty());
+  const auto raised = leak_alarms(flow);
+  ASSERT_EQ(raised.size(), 1u);
+  EXPECT_LT(raised.front().t, 93.0);
+  EXPECT_NEAR(raised.front().leak_coefficient, 2e-12, 0.5e-12);
+}
+
+// `learn_before_change: false`: the leak is learned as healthy, and `flow_law` looks back with
+// its own residual (the valve's flow in any motion) and says so in the event.
+TEST(LearnedChange, ToldToLearnOnEverythingFlowLawReportsItsFlowResidual) {
+  const capture::Capture full = with_leak_in_learning(7, 2e-12);
+  DaemonConfig config = default_replay_config(full);
+  ASSERT_EQ(config.actuators.size(), 1u);
+  config.actuators.front().detector = "flow_law";
+  config.actuators.front().detector_options =
+      config::ConfigNode::load_string("learn_before_change: false\n", "options.yaml");
+  const ReplayResult result = replay_capture(full, config);
+  EXPECT_TRUE(leak_alarms(result).empty());
+  const auto found = learned_changes(result);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found.front().channel, "u");
   EXPECT_EQ(found.front().feature, "flow_residual");
@@ -54,31 +85,16 @@ TEST(LearnedChange, ALeakOpeningDuringLearningIsReportedNearItsOnset) {
   EXPECT_NE(found.front().message.find("learning may have included a leak at t="),
             std::string::npos)
       << found.front().message;
-  EXPECT_NE(found.front().message.find("the valve's flow rose with the load"), std::string::npos)
+  EXPECT_NE(found.front().message.find("the valve's flow rose with the load as a leak of"),
+            std::string::npos)
+      << found.front().message;
+  EXPECT_NE(found.front().message.find("the flow_law detector learned that"), std::string::npos)
       << found.front().message;
   // The event log's JSON carries the time and the feature.
   const std::string json = to_json_line(found.front());
   EXPECT_NE(json.find("\"event\": \"learned_change\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"change_t\": "), std::string::npos) << json;
   EXPECT_NE(json.find("\"feature\": \"flow_residual\""), std::string::npos) << json;
-}
-
-// `detector: flow_law` looks back with its own residual (the valve's flow in any motion) and says
-// so in the event.
-TEST(LearnedChange, FlowLawReportsItsFlowResidual) {
-  const capture::Capture full = with_leak_in_learning(7, 2e-12);
-  DaemonConfig config = default_replay_config(full);
-  ASSERT_EQ(config.actuators.size(), 1u);
-  config.actuators.front().detector = "flow_law";
-  const auto found = learned_changes(replay_capture(full, config));
-  ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found.front().feature, "flow_residual");
-  EXPECT_NEAR(found.front().change_t, kOnset, 3.0);
-  EXPECT_NE(found.front().message.find("the valve's flow rose with the load as a leak of"),
-            std::string::npos)
-      << found.front().message;
-  EXPECT_NE(found.front().message.find("the flow_law detector learned that"), std::string::npos)
-      << found.front().message;
 }
 
 // With p1 and p2 only, the raw index moves by a fifth between the blocks of a healthy test
@@ -100,7 +116,9 @@ TEST(LearnedChange, AHealthyLearningPeriodIsNotReported) {
   for (const std::uint64_t seed : {3u, 4u}) {
     SCOPED_TRACE(seed);
     const capture::Capture healthy = with_leak_in_learning(seed, 0.0);
-    EXPECT_TRUE(learned_changes(replay(healthy)).empty());
+    const ReplayResult flow = replay(healthy);
+    EXPECT_TRUE(learned_changes(flow).empty());
+    EXPECT_TRUE(leak_alarms(flow).empty());
     EXPECT_TRUE(learned_changes(replay(test::columns_of(healthy, {"t", "p1", "p2"}))).empty());
   }
 }
@@ -137,7 +155,9 @@ TEST(LearnedChange, DriftWhileLearningIsNotReported) {
     s.duration_s = 100.0;
     s.conditions = c.conditions;
     const capture::Capture capture = sim::simulate(s);
-    EXPECT_TRUE(learned_changes(replay(capture)).empty());
+    const ReplayResult flow = replay(capture);
+    EXPECT_TRUE(learned_changes(flow).empty());
+    EXPECT_TRUE(leak_alarms(flow).empty());
     EXPECT_TRUE(learned_changes(replay(test::columns_of(capture, {"t", "p1", "p2"}))).empty());
   }
 }
