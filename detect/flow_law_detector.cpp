@@ -304,12 +304,13 @@ bool FlowLawDetector::resumes_after_hold() const {
 }
 
 // A rig that holds still for minutes and then moves would otherwise learn on a window that is
-// mostly the hold: the motion ends the wait within its first seconds, the leak check of the
-// learning period (probe_learned_change) finds no reference that identifies the load term in
-// the hold, and a leak opening in that motion is learned as healthy (issue 23: seed 3307 run
-// 32, a leak 35 s into a triangle after a 316 s hold, never raised). So the period starts over
-// with the motion, as a start in motion would, keeping the hold's newest seconds: its load is
-// then within the learned range.
+// largely the hold: the wait ends once a quarter of the window has moved away from the hold's
+// load (135 s into a triangle after a 316 s hold), the leak check of the learning period
+// (probe_learned_change) finds no reference that identifies the load term in the window's
+// first 40 %, and a leak opening in that motion is learned as healthy (issue 23: seed 3307 run
+// 32, a leak 35 s into the triangle, not raised). So the period starts over with the motion, as
+// a start in motion would, keeping the hold's newest seconds: its load is then within the
+// learned range.
 void FlowLawDetector::restart_learning_on_motion() {
   const std::size_t keep =
       std::min(learned_.size(), hops_in(kHoldSecondsKept, options_.block_seconds));

@@ -126,7 +126,8 @@ class FlowLawDetector final : public Detector {
   DetectorState export_state() const override;
   void import_state(const DetectorState& state) override;
   void resume_after_gap() override;
-  // A leak that opened while learning (learned_change.hpp), judged once when learning ends.
+  // A leak that opened while learning and was learned as healthy (learned_change.hpp), found
+  // once when learning ends; empty when learn_before_change left it out and judged it instead.
   std::optional<LearnedChange> learned_change() const override { return learned_change_; }
   double learning_seconds() const override {
     return options_.learning.settle_seconds + options_.learning.learn_seconds;
