@@ -19,7 +19,7 @@ namespace leakmon::pipeline {
 namespace {
 
 // config/demo.yaml's actuator, with `learn` and `on_delay` in place (state/events left out).
-DaemonConfig demo_config(int learn_seconds, double on_delay_s) {
+DaemonConfig demo_config(int learn_seconds, double on_delay_s, const std::string& options = "") {
   const std::string yaml =
       "drivers: [{name: rig, type: sim, scenario: healthy}]\n"
       "actuators:\n"
@@ -29,7 +29,7 @@ DaemonConfig demo_config(int learn_seconds, double on_delay_s) {
       "    detector:\n"
       "      kind: default\n"
       "      options: {settle_seconds: 2, learn_seconds: " +
-      std::to_string(learn_seconds) +
+      std::to_string(learn_seconds) + options +
       "}\n"
       "    alarm: {on_delay_s: " +
       std::to_string(on_delay_s) +
@@ -133,12 +133,25 @@ TEST(Reload, ChangingAlarmDelayKeepsTheLearnedStateAndTheLeakIsReported) {
   EXPECT_NE(run.metrics.find("cylinder relearns 0 remaining 0"), std::string::npos) << run.metrics;
 }
 
-// The control experiment: the same leak under the relearning reload falls into the learning
-// window and is not reported, which is why the relearning must be announced.
-TEST(Reload, TheLeakDuringRelearningIsNotReported) {
+// The same leak under the relearning reload falls into the learning window (60 s, 15 s into
+// it). The default with u and x finds it there and learns around it (`learn_before_change`):
+// raised when relearning ends. The control experiment, told to learn on everything: not
+// raised, which is why the relearning must be announced.
+TEST(Reload, TheLeakDuringRelearningIsRaisedWhenRelearningEnds) {
   const ReloadRun run = run_with_reload(demo_config(45, 1.0), demo_config(30, 1.0), 42.0);
   const auto raised = of_kind(run.events, io::EventKind::alarm_raised);
-  for (const auto& e : raised) EXPECT_NE(e.alarm, "internal_leakage") << e.t;
+  ASSERT_FALSE(raised.empty()) << "the leak at 60 s must be raised";
+  EXPECT_EQ(raised.front().alarm, "internal_leakage");
+  EXPECT_GT(raised.front().t, 74.0);  // when relearning ends (protected_from 74.8)
+  EXPECT_LT(raised.front().t, 80.0);
+
+  const std::string learn_on_all = ", learn_before_change: false";
+  const ReloadRun control =
+      run_with_reload(demo_config(45, 1.0, learn_on_all), demo_config(30, 1.0, learn_on_all), 42.0);
+  ASSERT_EQ(of_kind(control.events, io::EventKind::relearning).size(), 1u);
+  for (const auto& e : of_kind(control.events, io::EventKind::alarm_raised)) {
+    EXPECT_NE(e.alarm, "internal_leakage") << e.t;
+  }
 }
 
 }  // namespace
