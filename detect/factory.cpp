@@ -238,12 +238,8 @@ void set_piston_area(sim::Parameters& rig, double area) {
 // The flow balances' supply from the chambers at rest when there is no `ps` (both detectors).
 template <typename O>
 std::vector<Option<O>> estimate_supply_options() {
-  return {other_option<O>(
-      "estimate_supply", "", "true, false", "without `ps`: the supply from the chambers at rest",
-      [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-        if (node != nullptr) o.estimate_supply = node->get_bool(row.key, o.estimate_supply);
-      },
-      0.0, 0.0, [](O& o) { return std::string(o.estimate_supply ? "true" : "false"); })};
+  return {flag_option<O>("estimate_supply", "without `ps`: the supply from the chambers at rest",
+                         [](O& o) -> bool& { return o.estimate_supply; })};
 }
 
 // Both flow balances: how long a judged block keeps the decision judged (status, metrics).
@@ -321,16 +317,10 @@ std::vector<Option<FlowBalanceOptions>> flow_rows() {
                               "how long learning starts over for want of distinct rest loads "
                               "before it says it cannot learn [s]",
                               [](O& o) -> double& { return o.max_excitation_wait_seconds; }),
-             other_option<O>(
-                 "limit_to_learned", "", "true, false",
-                 "judge only blocks at rest within the learned rest loads (+- "
-                 "rest_load_tolerance)",
-                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-                   if (node != nullptr) {
-                     o.limit_to_learned = node->get_bool(row.key, o.limit_to_learned);
-                   }
-                 },
-                 0.0, 0.0, [](O& o) { return std::string(o.limit_to_learned ? "true" : "false"); }),
+             flag_option<O>("limit_to_learned",
+                            "judge only blocks at rest within the learned rest loads (+- "
+                            "rest_load_tolerance)",
+                            [](O& o) -> bool& { return o.limit_to_learned; }),
              number_option<O>("no_load_pressure", 0.0, 1e8,
                               "below this |p1 - p2| a block at rest is not judged (no_load) "
                               "[Pa]",
@@ -382,42 +372,22 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
                               "the spool's first-order lag tau [s]; learned around it unless "
                               "learn_spool_time_constant is false",
                               [](O& o) -> double& { return o.rig.tau; }),
-             other_option<O>(
-                 "learn_spool_time_constant", "", "true, false",
+             flag_option<O>(
+                 "learn_spool_time_constant",
                  "learn the spool's lag from the learning blocks (1/8 to 8 times the stated)",
-                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-                   if (node != nullptr) {
-                     o.learn_spool_time_constant =
-                         node->get_bool(row.key, o.learn_spool_time_constant);
-                   }
-                 },
-                 0.0, 0.0,
-                 [](O& o) { return std::string(o.learn_spool_time_constant ? "true" : "false"); }),
+                 [](O& o) -> bool& { return o.learn_spool_time_constant; }),
              number_option<O>("min_lag_share", 0.0, 1.0,
                               "... when, of the lag's spread over the learning blocks the other "
                               "terms leave, the load term leaves this share; else the stated lag",
                               [](O& o) -> double& { return o.min_lag_share; }),
-             other_option<O>(
-                 "learn_null_offset", "", "true, false",
+             flag_option<O>(
+                 "learn_null_offset",
                  "learn the valve's null-offset flow (a bias the command u does not show)",
-                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-                   if (node != nullptr) {
-                     o.learn_null_offset = node->get_bool(row.key, o.learn_null_offset);
-                   }
-                 },
-                 0.0, 0.0,
-                 [](O& o) { return std::string(o.learn_null_offset ? "true" : "false"); }),
-             other_option<O>(
-                 "learn_before_change", "", "true, false",
-                 "a leak that opened while learning: learn on the blocks before it and judge "
-                 "those after it (raised); false: learn on all and report it",
-                 [](O& o, const config::ConfigNode* node, const Option<O>& row) {
-                   if (node != nullptr) {
-                     o.learn_before_change = node->get_bool(row.key, o.learn_before_change);
-                   }
-                 },
-                 0.0, 0.0,
-                 [](O& o) { return std::string(o.learn_before_change ? "true" : "false"); }),
+                 [](O& o) -> bool& { return o.learn_null_offset; }),
+             flag_option<O>("learn_before_change",
+                            "a leak that opened while learning: learn on the blocks before it and "
+                            "judge those after it (raised); false: learn on all and report it",
+                            [](O& o) -> bool& { return o.learn_before_change; }),
              number_option<O>("min_load_spread", 0.0, 1e9,
                               "learning waits until the learning blocks' mean loads p1 - p2 "
                               "spread this much (std) [Pa]",

@@ -31,6 +31,8 @@ struct Option {
   std::string_view default_text = {}, range_text = {};
   // The default read from the options (instead of default_text).
   std::string (*default_of)(O&) = nullptr;
+  // A flag (true, false) at flag(options).
+  bool& (*flag)(O&) = nullptr;
 };
 
 template <class O>
@@ -45,6 +47,11 @@ Option<O> other_option(std::string_view key, std::string_view default_text,
                        void (*read)(O&, const config::ConfigNode*, const Option<O>&),
                        double lo = 0.0, double hi = 0.0, std::string (*default_of)(O&) = nullptr) {
   return {key, meaning, lo, hi, nullptr, read, default_text, range_text, default_of};
+}
+
+template <class O>
+Option<O> flag_option(std::string_view key, std::string_view meaning, bool& (*flag)(O&)) {
+  return {key, meaning, 0.0, 0.0, nullptr, nullptr, {}, "true, false", nullptr, flag};
 }
 
 template <class O>
@@ -68,6 +75,9 @@ void read_options(const std::vector<Option<O>>& rows, O& options, const config::
     if (row.field != nullptr) {
       double& value = row.field(options);
       if (node != nullptr) value = node->get_double(row.key, value, row.lo, row.hi);
+    } else if (row.flag != nullptr) {
+      bool& value = row.flag(options);
+      if (node != nullptr) value = node->get_bool(row.key, value);
     } else if (row.read != nullptr) {
       row.read(options, node, row);
     }
@@ -85,7 +95,9 @@ template <class O>
 std::string options_markdown(const std::vector<Option<O>>& rows, O defaults = O{}) {
   std::string out = "| key | default | range | meaning |\n|---|---|---|---|\n";
   for (const auto& row : rows) {
-    const std::string value = row.field != nullptr        ? option_number_text(row.field(defaults))
+    const std::string value = row.field != nullptr ? option_number_text(row.field(defaults))
+                              : row.flag != nullptr
+                                  ? std::string(row.flag(defaults) ? "true" : "false")
                               : row.default_of != nullptr ? row.default_of(defaults)
                                                           : std::string(row.default_text);
     const std::string range = row.range_text.empty()
