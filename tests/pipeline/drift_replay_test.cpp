@@ -9,6 +9,7 @@
 
 #include "pipeline/replay.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/event_filters.hpp"
 
 namespace leakmon::pipeline {
 namespace {
@@ -32,15 +33,6 @@ capture::Capture drifting_capture(bool record_temp) {
   return sim::simulate(s);
 }
 
-std::vector<io::Event> leak_alarms(const ReplayResult& result) {
-  std::vector<io::Event> out;
-  std::copy_if(result.events.begin(), result.events.end(), std::back_inserter(out),
-               [](const io::Event& e) {
-                 return e.kind == io::EventKind::alarm_raised && e.alarm == "internal_leakage";
-               });
-  return out;
-}
-
 TEST(DriftReplay, WarmUpAndSupplyChangeAreNotALeakAndTheLeakAfterIsSizedAt40C) {
   for (const bool with_temp : {true, false}) {
     SCOPED_TRACE(with_temp ? "temp column" : "no temp column");
@@ -48,7 +40,7 @@ TEST(DriftReplay, WarmUpAndSupplyChangeAreNotALeakAndTheLeakAfterIsSizedAt40C) {
     const DaemonConfig config = default_replay_config(capture);
     EXPECT_EQ(config.actuators.front().channels[capture::Role::temp].present(), with_temp);
     const ReplayResult result = replay_capture(capture, config);
-    const auto alarms = leak_alarms(result);
+    const auto alarms = test::leak_alarms(result.events);
     ASSERT_FALSE(alarms.empty());
     EXPECT_GT(alarms.front().t, kOnset);
     EXPECT_LT(alarms.front().t, kOnset + 60.0);

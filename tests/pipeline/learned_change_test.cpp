@@ -17,6 +17,7 @@
 #include "pipeline/replay.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/capture_slices.hpp"
+#include "tests/support/event_filters.hpp"
 
 namespace leakmon::pipeline {
 namespace {
@@ -24,10 +25,11 @@ namespace {
 constexpr double kOnset = 70.0;
 
 std::vector<io::Event> learned_changes(const ReplayResult& result) {
-  std::vector<io::Event> out;
-  std::copy_if(result.events.begin(), result.events.end(), std::back_inserter(out),
-               [](const io::Event& e) { return e.kind == io::EventKind::learned_change; });
-  return out;
+  return test::of_kind(result.events, io::EventKind::learned_change);
+}
+
+std::vector<io::Event> leak_alarms(const ReplayResult& result) {
+  return test::leak_alarms(result.events);
 }
 
 capture::Capture with_leak_in_learning(std::uint64_t seed, double c_l, double onset = kOnset) {
@@ -40,15 +42,6 @@ capture::Capture with_leak_in_learning(std::uint64_t seed, double c_l, double on
 
 ReplayResult replay(const capture::Capture& capture) {
   return replay_capture(capture, default_replay_config(capture));
-}
-
-std::vector<io::Event> leak_alarms(const ReplayResult& result) {
-  std::vector<io::Event> out;
-  std::copy_if(result.events.begin(), result.events.end(), std::back_inserter(out),
-               [](const io::Event& e) {
-                 return e.kind == io::EventKind::alarm_raised && e.alarm == "internal_leakage";
-               });
-  return out;
 }
 
 // The default with u and x learns on the 68 s before the leak and judges the rest: the leak is

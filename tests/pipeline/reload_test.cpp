@@ -14,6 +14,7 @@
 #include "pipeline/worker.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/event_filters.hpp"
 
 namespace leakmon::pipeline {
 namespace {
@@ -97,12 +98,7 @@ ReloadRun run_with_reload(const DaemonConfig& initial, const DaemonConfig& reloa
   return run;
 }
 
-std::vector<io::Event> of_kind(const std::vector<io::Event>& events, io::EventKind kind) {
-  std::vector<io::Event> out;
-  std::copy_if(events.begin(), events.end(), std::back_inserter(out),
-               [&](const io::Event& e) { return e.kind == kind; });
-  return out;
-}
+using test::of_kind;
 
 TEST(Reload, ChangingLearnSecondsAnnouncesRelearning) {
   const ReloadRun run = run_with_reload(demo_config(45, 1.0), demo_config(30, 1.0), 42.0);
