@@ -89,6 +89,10 @@ int run_evaluate_cases(int argc, char** argv) {
                  "OUT/cases.csv and OUT/summary.md (accuracy and confusion matrix).");
   args.option("cases", "N", "number of cases", "24")
       .option("seed", "S", "seed of the first case; case i uses S + i", "1")
+      .option("first-case", "K",
+              "start at case K of the sequence (its seed S + K, its class and effect), to "
+              "resume a run or draw one case of it again: --first-case 33 --cases 34",
+              "0")
       .option("duration", "SECONDS", "length of each simulated capture", "60")
       .option("classes", "LIST",
               "comma-separated case classes, taken in turn: library (the eleven effects and "
@@ -107,6 +111,10 @@ int run_evaluate_cases(int argc, char** argv) {
   const long long cases = args.get_int("cases");
   if (cases < 1) throw UsageError("option '--cases': must be at least 1");
   const auto first = static_cast<std::uint64_t>(args.get_int("seed"));
+  const long long first_case = args.get_int("first-case");
+  if (first_case < 0 || first_case >= cases) {
+    throw UsageError("option '--first-case': must be at least 0 and less than --cases");
+  }
   model::CaseSettings case_settings;
   case_settings.duration_s = args.get_double("duration");
   const std::string rigs = args.get("rigs");
@@ -129,7 +137,7 @@ int run_evaluate_cases(int argc, char** argv) {
   const std::string dir = args.get("out");
   std::filesystem::create_directories(dir);
   model::EvaluationSummary summary;
-  for (long long i = 0; i < cases; ++i) {
+  for (long long i = first_case; i < cases; ++i) {
     const auto index = static_cast<std::size_t>(i);
     const auto& kind = kinds[index % kinds.size()];
     const auto [effect, settings] = model::case_of_kind(kind, index / kinds.size(), case_settings);

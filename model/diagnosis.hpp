@@ -124,11 +124,17 @@ struct DiagnosisSettings {
   double moving_share = 0.25;
   double onset_search_s = 4.0;
   double onset_step_s = 0.05;
+  // While the flat stretch of the summed errors reaches the search window's edge, the window is
+  // widened on that side by 2 x onset_search_s (the number of trials kept), at most this many
+  // times (to 28 s on that side).
+  std::size_t onset_search_widenings = 3;
   // Trial onsets whose summed error lies within this share of the search's range (largest
   // minus smallest) above the smallest form the flat stretch whose middle is the onset (an
   // effect invisible during a hold; the closed loop's small corrections during it make the
   // stretch differ by a few per cent, the step into it by orders of magnitude).
   double onset_flat_share = 0.02;
+  // ... and within this share of the smallest sum itself.
+  double onset_flat_relative = 0.05;
   // The stated values the data can check (rig_check.hpp); a finding is named only when the
   // corrected rig's calibrated nominal model also predicts the held-out data better than the
   // stated rig's, with step 1's score and significance.

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "model/diagnosis.hpp"
 #include "model/evaluation.hpp"
@@ -189,6 +190,25 @@ TEST(Onset, EffectShowingOnlyInMotionIsNamedWithItsOnset) {
               d.change_point ? d.change_point->statistic : 0.0);
   ASSERT_EQ(causes(d), "supply_droop");
   EXPECT_NEAR(d.causes.front().onset_s, c.onset_s, 2.0);
+}
+
+// Fixed cases 811031 and 811029 of `model evaluate --rigs other --classes misstated,onset
+// --seed 811000` (180 s): a supply droop from 109.0 s whose change point lay at 118.5 s, and a
+// 42 ms spool lag from 124.6 s split at 129.5 s. Both show only while the piston moves; the
+// onset search (+-4 s around the split) found the summed error still falling, or flat, at its
+// window's edge, and took 116.55 s and 127.5 s (7.5 s and 2.9 s late). The window now widens
+// while the flat stretch reaches its edge: named alone with the onset within 2 s.
+TEST(Onset, AnOnsetHoldsBeforeTheChangePointIsFoundByWideningTheSearch) {
+  for (const auto& [seed, effect] :
+       {std::pair<std::uint64_t, const char*>{811031, "supply_droop"}, {811029, "spool_lag"}}) {
+    const SyntheticCase c = draw_case(seed, effect, onset_on_other_rig(180.0));
+    const Diagnosis d = diagnose_case(c);
+    std::printf("  true onset %.2f s; change point %.2f s (t %.1f)\n", c.onset_s,
+                d.change_point ? d.change_point->t_s : 0.0,
+                d.change_point ? d.change_point->statistic : 0.0);
+    ASSERT_EQ(causes(d), effect) << seed;
+    EXPECT_NEAR(d.causes.front().onset_s, c.onset_s, 2.0) << seed;
+  }
 }
 
 // A spectral line that passes its test but whose ripple fit gains nothing is never named ahead
