@@ -5,23 +5,15 @@
 #include <cmath>
 #include <vector>
 
+#include "model/piston_velocity.hpp"
 #include "sim/friction.hpp"
 
 namespace leakmon::model {
 namespace {
 
-constexpr int kVelocityHalfWindow = 3;  // as the segment predictor's velocity estimate
-constexpr int kMaxUnknowns = 7;         // m, b, F_C, constant, p1 lag, p2 lag (, K_s)
+constexpr int kMaxUnknowns = 7;  // m, b, F_C, constant, p1 lag, p2 lag (, K_s)
 
-// Velocity from a least-squares line through x over +-3 samples.
-double velocity(const MeasuredRecord& r, std::size_t k) {
-  double slope = 0.0, weight = 0.0;
-  for (int i = -kVelocityHalfWindow; i <= kVelocityHalfWindow; ++i) {
-    slope += i * r.x[static_cast<std::size_t>(static_cast<long>(k) + i)];
-    weight += i * i;
-  }
-  return slope / (weight * r.dt);
-}
+double velocity(const MeasuredRecord& r, std::size_t k) { return PistonVelocity::at(r.x, k, r.dt); }
 
 }  // namespace
 
@@ -38,7 +30,7 @@ ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<cons
   const double spring = free_stiffness ? 0.0 : rig.K_s;
   std::vector<std::array<double, kMaxUnknowns + 1>> rows;
   for (const auto& seg : segments) {
-    // Segments are gap-free with kVelocityHalfWindow valid samples on either side.
+    // Segments are gap-free with PistonVelocity::kHalfWindow valid samples on either side.
     for (std::size_t a = seg.begin; a + window_samples < seg.begin + seg.length;
          a += window_samples) {
       const std::size_t z = a + window_samples;

@@ -96,9 +96,10 @@ class SegmentPredictor {
   // noise is the rig table's (it is not separable from the data at the sample level).
   NoiseLevels noise_levels() const;
   // The held-out NRMSE that the noise alone leaves (FORMATS.md `nrmse_floor`): `parameters`
-  // simulated from each segment's start with the spool flow noise drawn, read through the
-  // transducer noise, against the same model's deterministic prediction from a start read
-  // through that noise, i.e. what a correct model scores. Averaged over `repeats` draws. Per
+  // simulated from a few samples before each segment's start with the spool flow noise drawn,
+  // read through the transducer noise, against the same model's deterministic prediction from
+  // the start read off those readings (the velocity fitted to them as to the capture), i.e.
+  // what a correct model scores. Averaged over `repeats` draws. Per
   // channel (x, p1, p2); FORMATS.md's value is their mean, as for nrmse.
   // `pieces`: the spool flow noise is held over this many equal parts of each sample (an
   // exact Ornstein-Uhlenbeck draw at their spacing); 1 holds each sample's mean.
@@ -126,7 +127,7 @@ class SegmentPredictor {
   const MeasuredRecord& record_;
   sim::Parameters rig_;
   ChannelScales scales_;
-  std::vector<double> velocity_;   // from a local least-squares line through x
+  std::vector<double> velocity_;   // of x, model/piston_velocity.hpp
   std::vector<double> dp1_, dp2_;  // central differences of the pressure readings
   // Everything spool_positions reads from its models (the spool's tau, u0 and u_max, then the
   // same before an onset and the onset's time; zeros without one): equal laws give equal
