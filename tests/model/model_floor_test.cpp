@@ -29,6 +29,25 @@ CaseSettings short_case() {
   return s;
 }
 
+// The generator's true model on a capture drawn afresh: its held-out NRMSE, and the noise
+// floor (mean over x, p1, p2) drawn from it with the diagnosis's own floor settings.
+std::pair<double, double> true_model_and_floor(std::uint64_t seed, const CaseSettings& settings) {
+  const DiagnosisSettings diagnosis;
+  const SyntheticCase c = draw_case(seed, "none", settings);
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const SegmentPredictor predictor(record, c.scenario.params);
+  const auto plan = split_record(record);
+  const ModelParameters truth = true_model(c);
+  const double achieved = predictor.nrmse(truth, plan.held_out);
+  const auto floor =
+      predictor.noise_floor(truth, plan.held_out, predictor.noise_levels(), diagnosis.floor_seed,
+                            diagnosis.floor_repeats, diagnosis.floor_noise_pieces);
+  const double mean_floor = (floor[0] + floor[1] + floor[2]) / 3.0;
+  std::printf("seed %llu: true model's held-out NRMSE %.5f, floor %.5f (ratio %.3f)\n",
+              static_cast<unsigned long long>(seed), achieved, mean_floor, mean_floor / achieved);
+  return {achieved, mean_floor};
+}
+
 // MODEL.md's transducers: pressure noise 5 kPa on a 5 kPa LSB, position noise 5 um on a 10 um
 // resolution; the quantisation adds LSB^2 / 12 to the variance. The estimate must find them
 // on a capture whose plant moves (third differences of the motion are small but not zero).
@@ -79,21 +98,9 @@ TEST(NoiseFloor, FollowsTheContinuousFlowNoiseOnAStiffLightRig) {
   CaseSettings other = short_case();
   other.duration_s = 60.0;
   other.other_rig = true;
-  const DiagnosisSettings diagnosis;
   for (const auto& [seed, settings] :
        {std::pair{std::uint64_t{761025}, other}, std::pair{std::uint64_t{771003}, short_case()}}) {
-    const SyntheticCase c = draw_case(seed, "none", settings);
-    const MeasuredRecord record = measured_record(simulate_case(c));
-    const SegmentPredictor predictor(record, c.scenario.params);
-    const auto plan = split_record(record);
-    const ModelParameters truth = true_model(c);
-    const double achieved = predictor.nrmse(truth, plan.held_out);
-    const auto floor =
-        predictor.noise_floor(truth, plan.held_out, predictor.noise_levels(), diagnosis.floor_seed,
-                              diagnosis.floor_repeats, diagnosis.floor_noise_pieces);
-    const double mean_floor = (floor[0] + floor[1] + floor[2]) / 3.0;
-    std::printf("seed %llu: true model's held-out NRMSE %.5f, floor %.5f (ratio %.3f)\n",
-                static_cast<unsigned long long>(seed), achieved, mean_floor, mean_floor / achieved);
+    const auto [achieved, mean_floor] = true_model_and_floor(seed, settings);
     EXPECT_GT(mean_floor, 0.85 * achieved) << "seed " << seed;
     EXPECT_LT(mean_floor, 1.2 * achieved) << "seed " << seed;
   }
@@ -110,19 +117,7 @@ TEST(NoiseFloor, IncludesTheStartVelocitysErrorOnARigHuntingAtItsMode) {
   CaseSettings other = short_case();
   other.duration_s = 180.0;
   other.other_rig = true;
-  const DiagnosisSettings diagnosis;
-  const SyntheticCase c = draw_case(812000, "none", other);
-  const MeasuredRecord record = measured_record(simulate_case(c));
-  const SegmentPredictor predictor(record, c.scenario.params);
-  const auto plan = split_record(record);
-  const ModelParameters truth = true_model(c);
-  const double achieved = predictor.nrmse(truth, plan.held_out);
-  const auto floor =
-      predictor.noise_floor(truth, plan.held_out, predictor.noise_levels(), diagnosis.floor_seed,
-                            diagnosis.floor_repeats, diagnosis.floor_noise_pieces);
-  const double mean_floor = (floor[0] + floor[1] + floor[2]) / 3.0;
-  std::printf("true model's held-out NRMSE %.4f, floor %.4f (ratio %.3f)\n", achieved, mean_floor,
-              mean_floor / achieved);
+  const auto [achieved, mean_floor] = true_model_and_floor(812000, other);
   EXPECT_GT(achieved, 0.2);  // the rig hunts: far above what the transducers' noise leaves
   EXPECT_GT(mean_floor, 0.8 * achieved);
   EXPECT_LT(mean_floor, 1.25 * achieved);
