@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string_view>
 
@@ -20,6 +21,128 @@ struct RowOrigin {
     return lines.empty() ? fmt::format("row {}", row + 1) : fmt::format("{}", lines[row]);
   }
 };
+
+// Marks the samples where a pressure sits at its range end invalid (MeasuredRecord::Censored).
+void censor_range_end(MeasuredRecord& rec, std::string_view name,
+                      const std::vector<double>& channel, const RowOrigin& origin,
+                      const RecordRequirements& req) {
+  const std::size_t n = rec.size();
+  double top = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (rec.valid[i]) top = std::max(top, channel[i]);
+  }
+  double below = -std::numeric_limits<double>::infinity();
+  std::size_t at_top = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!rec.valid[i]) continue;
+    if (channel[i] == top) {
+      ++at_top;
+    } else {
+      below = std::max(below, channel[i]);
+    }
+  }
+  std::size_t at_below = 0;
+  for (std::size_t i = 0; i < n; ++i) at_below += rec.valid[i] && channel[i] == below;
+  // A channel reading one value throughout shows no range end, only a constant level.
+  if (!std::isfinite(below) || at_top < req.pinned_min_samples ||
+      static_cast<double>(at_top) <
+          req.pinned_ratio * static_cast<double>(std::max<std::size_t>(at_below, 1))) {
+    return;
+  }
+  MeasuredRecord::Censored censored{
+      MeasuredRecord::Censored::Reason::range_end, std::string(name), top, at_top, 0, ""};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!rec.valid[i] || channel[i] != top) continue;
+    if (censored.first.empty()) censored.first = origin.where(i);
+    rec.valid[i] = false;
+  }
+  rec.censored.push_back(std::move(censored));
+}
+
+// Replaces isolated spikes by their neighbours' median (RecordRequirements::spike_scales).
+void clean_spikes(MeasuredRecord& rec, std::string_view name, std::vector<double>& channel,
+                  const RowOrigin& origin, const RecordRequirements& req) {
+  const std::size_t n = rec.size();
+  if (n < 5) return;
+  struct Candidate {
+    std::size_t row;
+    double median, deviation, spread;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> deviations;
+  for (std::size_t k = 2; k + 2 < n; ++k) {
+    if (!(rec.valid[k - 2] && rec.valid[k - 1] && rec.valid[k] && rec.valid[k + 1] &&
+          rec.valid[k + 2])) {
+      continue;
+    }
+    std::array<double, 4> around = {channel[k - 2], channel[k - 1], channel[k + 1], channel[k + 2]};
+    std::sort(around.begin(), around.end());
+    // The lower median: a reading the channel took, so a replaced spike adds no value of its
+    // own (censor_range_end counts how often each value occurs).
+    const double median = around[1];
+    candidates.push_back({k, median, channel[k] - median, around[3] - around[0]});
+    deviations.push_back(std::abs(channel[k] - median));
+  }
+  if (deviations.empty()) return;
+  const auto mid = deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2);
+  std::nth_element(deviations.begin(), mid, deviations.end());
+  // The noise's scale; on a quantised channel at rest the median deviation can be 0, so at
+  // least the smallest step the channel takes.
+  double step = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < n; ++k) {
+    const double d = std::abs(channel[k] - channel[k - 1]);
+    if (d > 0.0 && std::isfinite(d)) step = std::min(step, d);
+  }
+  const double scale = std::max(1.4826 * *mid, std::isfinite(step) ? step : 0.0);
+  if (!(scale > 0.0)) return;
+  std::vector<Candidate> spikes;
+  for (const auto& c : candidates) {
+    if (std::abs(c.deviation) > req.spike_scales * scale &&
+        std::abs(c.deviation) > req.spike_spread * c.spread) {
+      spikes.push_back(c);
+    }
+  }
+  if (spikes.empty() ||
+      static_cast<double>(spikes.size()) > req.max_spikes_per_min * rec.duration() / 60.0) {
+    return;
+  }
+  MeasuredRecord::Censored cleaned{MeasuredRecord::Censored::Reason::spikes,
+                                   std::string(name),
+                                   0.0,
+                                   spikes.size(),
+                                   spikes.size(),
+                                   origin.where(spikes[0].row)};
+  for (const auto& c : spikes) {
+    channel[c.row] = c.median;
+    if (std::abs(c.deviation) > std::abs(cleaned.value)) cleaned.value = c.deviation;
+  }
+  rec.censored.push_back(std::move(cleaned));
+}
+
+// Marks runs of one exact value lasting `held_min_s` or longer invalid.
+void censor_held(MeasuredRecord& rec, std::string_view name, const std::vector<double>& channel,
+                 const RowOrigin& origin, const RecordRequirements& req) {
+  const std::size_t n = rec.size();
+  const auto min_run = static_cast<std::size_t>(std::ceil(req.held_min_s / rec.dt));
+  MeasuredRecord::Censored censored{
+      MeasuredRecord::Censored::Reason::held, std::string(name), 0.0, 0, 0, ""};
+  std::size_t begin = 0;
+  for (std::size_t i = 1; i <= n; ++i) {
+    if (i < n && channel[i] == channel[begin]) continue;
+    if (i - begin >= min_run && std::isfinite(channel[begin])) {
+      if (censored.runs++ == 0) {
+        censored.value = channel[begin];
+        censored.first = origin.where(begin);
+      }
+      for (std::size_t k = begin; k < i; ++k) {
+        censored.samples += rec.valid[k];
+        rec.valid[k] = false;
+      }
+    }
+    begin = i;
+  }
+  if (censored.runs > 0) rec.censored.push_back(std::move(censored));
+}
 
 MeasuredRecord vet(MeasuredRecord rec, const RowOrigin& origin, const RecordRequirements& req) {
   const std::size_t n = rec.size();
@@ -69,6 +192,36 @@ MeasuredRecord vet(MeasuredRecord rec, const RowOrigin& origin, const RecordRequ
         "accepts at most {:.1f} %",
         rec.source, 100.0 * gap_fraction, origin.where(first_gap->first), first_gap->second,
         100.0 * req.max_gap_fraction));
+  }
+  clean_spikes(rec, "x", rec.x, origin, req);
+  clean_spikes(rec, "p1", rec.p1, origin, req);
+  clean_spikes(rec, "p2", rec.p2, origin, req);
+  censor_held(rec, "x", rec.x, origin, req);
+  censor_held(rec, "p1", rec.p1, origin, req);
+  censor_held(rec, "p2", rec.p2, origin, req);
+  censor_range_end(rec, "p1", rec.p1, origin, req);
+  censor_range_end(rec, "p2", rec.p2, origin, req);
+  std::size_t censored = 0;
+  // Spikes were replaced, not left out.
+  const auto left_out = [](const MeasuredRecord::Censored& c) {
+    return c.reason == MeasuredRecord::Censored::Reason::spikes ? std::size_t{0} : c.samples;
+  };
+  for (const auto& c : rec.censored) censored += left_out(c);
+  const double censored_fraction = static_cast<double>(censored) / static_cast<double>(n);
+  if (censored_fraction > req.max_censored_fraction) {
+    const auto& worst =
+        *std::max_element(rec.censored.begin(), rec.censored.end(),
+                          [&](const auto& a, const auto& b) { return left_out(a) < left_out(b); });
+    const bool range_end = worst.reason == MeasuredRecord::Censored::Reason::range_end;
+    throw ModelCheckError(fmt::format(
+        "{}:{}: column {} {} {} on {} samples{}; {:.1f} % of the capture is left out as "
+        "transducer faults or clipping and the model check accepts at most {:.1f} %",
+        rec.source, worst.first, worst.channel,
+        range_end ? "sits at its largest reading (a transducer's range end),"
+                  : "holds one exact value (a frozen, dropped-out or saturated transducer),",
+        worst.value, worst.samples,
+        range_end ? "" : fmt::format(" in {} run(s) of {} s or more", worst.runs, req.held_min_s),
+        100.0 * censored_fraction, 100.0 * req.max_censored_fraction));
   }
   return rec;
 }

@@ -108,6 +108,27 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
       "part and scored on {} held-out segments (open-loop simulation on the "
       "measured command from the measured state, see docs/model-check.md).\n\n",
       r.duration(), 1.0 / r.dt, d.fitting_used.size(), d.held_out_used.size());
+  for (const auto& c : r.censored) {
+    if (c.reason == MeasuredRecord::Censored::Reason::range_end) {
+      out += fmt::format(
+          "{} sits at its largest reading, {:.4g} MPa, on {} samples (the first at {}): a "
+          "transducer's range end, which the pressure went past. Those samples say only \"at "
+          "least this much\" and are left out like gaps; a transducer with more range would "
+          "keep them.\n\n",
+          c.channel, c.value * 1e-6, c.samples, c.first);
+    } else if (c.reason == MeasuredRecord::Censored::Reason::spikes) {
+      out += fmt::format(
+          "{} spikes: {} isolated samples (the first at {}, the largest {:.4g} off) were replaced "
+          "by the median of their neighbours.\n\n",
+          c.channel, c.samples, c.first, c.value);
+    } else {
+      out += fmt::format(
+          "{} holds one exact value for {} s or longer {} time(s), {} samples in all (the first "
+          "at {}, reading {:.6g}): a frozen, dropped-out or saturated transducer, since a "
+          "working one moves by about an LSB even at rest. Left out like gaps.\n\n",
+          c.channel, RecordRequirements{}.held_min_s, c.runs, c.samples, c.first, c.value);
+    }
+  }
   out += rig_section(d);
   out += "## Verdict\n\n";
   out += fmt::format(

@@ -55,9 +55,9 @@ struct RigCheckSettings {
   // this factor.
   double supply_over_offset = 2.0;
   // The load stiffness is contradicted when the force balance's K_s is off the stated one by
-  // more than this share of it, by more than `z` standard errors, and by more than
-  // `stiffness_floor` times A (ps - pt) / 0.05 m (a spring force of 1 % of the actuator's
-  // force at the paper's largest step, for rigs stated without a spring).
+  // more than this share of it and by more than `z` standard errors; on a rig stated with a
+  // spring below `stiffness_floor` times A (ps - pt) / 0.05 m (a spring force of 1 % of the
+  // actuator's force at the paper's largest step), or without one, by more than that floor.
   double stiffness_tolerance = 0.15;
   double stiffness_floor = 0.01;
   double z = 5.0;
