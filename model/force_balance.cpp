@@ -15,6 +15,11 @@ constexpr int kMaxUnknowns = 7;  // m, b, F_C, constant, p1 lag, p2 lag (, K_s)
 
 double velocity(const MeasuredRecord& r, std::size_t k) { return PistonVelocity::at(r.x, k, r.dt); }
 
+// The friction regressor's sign of v: PistonVelocity::line_at says why not the cubic.
+double friction_velocity(const MeasuredRecord& r, std::size_t k) {
+  return PistonVelocity::line_at(r.x, k, r.dt);
+}
+
 }  // namespace
 
 bool usable(const ForceBalance& estimate, double stated_m) {
@@ -42,8 +47,8 @@ ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<cons
         load += 0.5 * record.dt * (force(k) + force(k + 1));
         displacement += 0.5 * record.dt * (record.x[k] + record.x[k + 1]);
         friction += 0.5 * record.dt *
-                    (sim::coulomb_friction(1.0, velocity(record, k)) +
-                     sim::coulomb_friction(1.0, velocity(record, k + 1)));
+                    (sim::coulomb_friction(1.0, friction_velocity(record, k)) +
+                     sim::coulomb_friction(1.0, friction_velocity(record, k + 1)));
       }
       const double span = static_cast<double>(window_samples) * record.dt;
       std::array<double, kMaxUnknowns + 1> row{velocity(record, z) - velocity(record, a),

@@ -50,6 +50,23 @@ class PistonVelocity {
     return sum / dt;
   }
 
+  // The least-squares line through +-3 samples: for the sign of the velocity where it turns
+  // sharply. A piston held by Coulomb friction stops within a sample or two; the cubic's 26 ms
+  // spread that kink, the force balance's friction regressor tanh(v / 1 mm/s) followed, and
+  // its mass came out 11 % high in the median (17 of 87 draws beyond 20 %) against +1 % with
+  // the line.
+  static double line_at(const std::vector<double>& x, std::size_t k, double dt) {
+    double sum = 0.0, weight = 0.0;
+    for (int i = 1; i <= kLineHalfWindow; ++i) {
+      const auto up = static_cast<std::size_t>(static_cast<long>(k) + i);
+      const auto down = static_cast<std::size_t>(static_cast<long>(k) - i);
+      sum += i * (x[up] - x[down]);
+      weight += 2.0 * i * i;
+    }
+    return sum / (weight * dt);
+  }
+  static constexpr int kLineHalfWindow = 3;
+
   // Standard deviation of the estimate per unit of white position noise, times dt.
   static double noise_gain() {
     double sum = 0.0;
