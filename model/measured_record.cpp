@@ -27,22 +27,28 @@ void censor_range_end(MeasuredRecord& rec, std::string_view name,
                       const std::vector<double>& channel, const RowOrigin& origin,
                       const RecordRequirements& req) {
   const std::size_t n = rec.size();
+  // One pass keeping the two largest distinct readings and how often each occurs.
   double top = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (rec.valid[i]) top = std::max(top, channel[i]);
-  }
   double below = -std::numeric_limits<double>::infinity();
   std::size_t at_top = 0;
+  std::size_t at_below = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!rec.valid[i]) continue;
-    if (channel[i] == top) {
+    const double v = channel[i];
+    if (v == top) {
       ++at_top;
-    } else {
-      below = std::max(below, channel[i]);
+    } else if (v > top) {
+      below = top;
+      at_below = at_top;
+      top = v;
+      at_top = 1;
+    } else if (v == below) {
+      ++at_below;
+    } else if (v > below) {
+      below = v;
+      at_below = 1;
     }
   }
-  std::size_t at_below = 0;
-  for (std::size_t i = 0; i < n; ++i) at_below += rec.valid[i] && channel[i] == below;
   // A channel reading one value throughout shows no range end, only a constant level.
   if (!std::isfinite(below) || at_top < req.pinned_min_samples ||
       static_cast<double>(at_top) <
@@ -50,7 +56,7 @@ void censor_range_end(MeasuredRecord& rec, std::string_view name,
     return;
   }
   MeasuredRecord::Censored censored{
-      MeasuredRecord::Censored::Reason::range_end, std::string(name), top, at_top, 0, ""};
+      MeasuredRecord::Censored::Reason::range_end, std::string(name), top, at_top, 0, "", 0.0};
   for (std::size_t i = 0; i < n; ++i) {
     if (!rec.valid[i] || channel[i] != top) continue;
     if (censored.first.empty()) censored.first = origin.where(i);
@@ -111,7 +117,8 @@ void clean_spikes(MeasuredRecord& rec, std::string_view name, std::vector<double
                                    0.0,
                                    spikes.size(),
                                    spikes.size(),
-                                   origin.where(spikes[0].row)};
+                                   origin.where(spikes[0].row),
+                                   0.0};
   for (const auto& c : spikes) {
     channel[c.row] = c.median;
     if (std::abs(c.deviation) > std::abs(cleaned.value)) cleaned.value = c.deviation;
@@ -125,7 +132,7 @@ void censor_held(MeasuredRecord& rec, std::string_view name, const std::vector<d
   const std::size_t n = rec.size();
   const auto min_run = static_cast<std::size_t>(std::ceil(req.held_min_s / rec.dt));
   MeasuredRecord::Censored censored{
-      MeasuredRecord::Censored::Reason::held, std::string(name), 0.0, 0, 0, ""};
+      MeasuredRecord::Censored::Reason::held, std::string(name), 0.0, 0, 0, "", req.held_min_s};
   std::size_t begin = 0;
   for (std::size_t i = 1; i <= n; ++i) {
     if (i < n && channel[i] == channel[begin]) continue;

@@ -41,6 +41,7 @@ struct MeasuredRecord {
     std::size_t samples = 0;  // samples left out (spikes: replaced by their neighbours' median)
     std::size_t runs = 0;     // held: how many runs
     std::string first;        // where the first one is (file line or row)
+    double held_min_s = 0.0;  // held: the run length that counted as held [s]
   };
   std::vector<Censored> censored;
 

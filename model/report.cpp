@@ -126,7 +126,7 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
           "{} holds one exact value for {} s or longer {} time(s), {} samples in all (the first "
           "at {}, reading {:.6g}): a frozen, dropped-out or saturated transducer, since a "
           "working one moves by about an LSB even at rest. Left out like gaps.\n\n",
-          c.channel, RecordRequirements{}.held_min_s, c.runs, c.samples, c.first, c.value);
+          c.channel, c.held_min_s, c.runs, c.samples, c.first, c.value);
     }
   }
   out += rig_section(d);

@@ -1,5 +1,7 @@
 #include "model/rig_check.hpp"
 
+#include "model/piston_velocity.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -7,7 +9,6 @@
 namespace leakmon::model {
 namespace {
 
-constexpr int kVelocityHalfWindow = 3;   // as the segment predictor's velocity estimate
 constexpr double kReferenceStep = 0.05;  // m: the paper's largest reference level
 
 double median(std::vector<double> v) {
@@ -55,20 +56,16 @@ RigCheck check_rig(const MeasuredRecord& record, std::span<const Segment> fittin
     double speed, command, sum;
   };
   std::vector<Sample> samples;
-  double weight = 0.0;
-  for (int i = 1; i <= kVelocityHalfWindow; ++i) weight += 2.0 * i * i;
+  // The rest share is the slowest samples; the short line tells rest from motion as well as
+  // the cubic and does not smear a sticking piston's stop into its neighbours.
+  constexpr auto half = static_cast<std::size_t>(PistonVelocity::kLineHalfWindow);
   const std::size_t n = record.size();
-  for (std::size_t k = kVelocityHalfWindow; k + kVelocityHalfWindow < n; ++k) {
+  for (std::size_t k = half; k + half < n; ++k) {
     bool valid = true;
-    double slope = 0.0;
-    for (int i = -kVelocityHalfWindow; i <= kVelocityHalfWindow; ++i) {
-      const auto j = static_cast<std::size_t>(static_cast<long>(k) + i);
-      valid = valid && record.valid[j];
-      slope += i * record.x[j];
-    }
+    for (std::size_t j = k - half; j <= k + half; ++j) valid = valid && record.valid[j];
     if (!valid) continue;
-    samples.push_back({std::abs(slope / (weight * record.dt)), std::abs(record.u[k]),
-                       record.p1[k] + record.p2[k]});
+    samples.push_back({std::abs(PistonVelocity::line_at(record.x, k, record.dt)),
+                       std::abs(record.u[k]), record.p1[k] + record.p2[k]});
   }
   const auto share = [&](double fraction, auto key) {
     std::vector<Sample> sorted = samples;

@@ -423,20 +423,11 @@ TEST(SensorFaults, HeldRunsAreLeftOutAndNeitherHideNorMakeACause) {
     CaseSettings settings;
     settings.duration_s = 180.0;
     SyntheticCase c = draw_case(700001, effect, settings);
-    const auto fault = [](Kind kind, SensorChannel channel, double start_s) {
-      sim::SensorFault f;
-      f.kind = kind;
-      f.channel = channel;
-      f.start_s = start_s;
-      f.duration_s = 3.0;
-      return f;
-    };
-    c.scenario.faults = {fault(Kind::frozen, SensorChannel::p1, 30.0),
-                         fault(Kind::dropout, SensorChannel::p2, 70.0),
-                         fault(Kind::frozen, SensorChannel::x, 110.0),
-                         fault(Kind::saturated, SensorChannel::p1, 150.0),
-                         fault(Kind::spikes, SensorChannel::p2, 0.0)};
-    c.scenario.faults.back().duration_s = 180.0;
+    c.scenario.faults = {sim::SensorFault{Kind::frozen, SensorChannel::p1, 30.0, 3.0},
+                         sim::SensorFault{Kind::dropout, SensorChannel::p2, 70.0, 3.0},
+                         sim::SensorFault{Kind::frozen, SensorChannel::x, 110.0, 3.0},
+                         sim::SensorFault{Kind::saturated, SensorChannel::p1, 150.0, 3.0},
+                         sim::SensorFault{Kind::spikes, SensorChannel::p2, 0.0, 180.0}};
     const MeasuredRecord record = measured_record(simulate_case(c));
     std::size_t left_out = 0;
     std::size_t spikes = 0;
