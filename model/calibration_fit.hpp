@@ -26,6 +26,10 @@ struct FitSettings {
   // Answer the solver's repeated requests for the same point from the evaluations kept (the
   // same numbers, one simulation fewer per solver step); false simulates every request.
   bool reuse_evaluations = true;
+  // A Jacobian column of an effect that starts inside the capture simulates only the segments
+  // that reach its onset (the others' residuals cannot change: the same numbers, a share of
+  // the simulation saved); false simulates every segment for every column.
+  bool skip_segments_before_onset = true;
 };
 
 struct FitResult {

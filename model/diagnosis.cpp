@@ -371,7 +371,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // Every candidate that can start at a time is tried from the change point, not only the
   // leading screened ones: fitted as constant effects, an effect that starts late in the
   // capture ranks below others that absorb part of its misfit everywhere (seed 796018's droop).
-  if (d.change_point && d.change_point->statistic >= settings.min_change_statistic) {
+  const auto suggests_onset = [&](const ChangePoint& split) {
+    return split.statistic >= settings.min_change_statistic ||
+           (split.statistic >= settings.min_large_change_statistic &&
+            split.step >= settings.large_change_step);
+  };
+  if (d.change_point && suggests_onset(*d.change_point)) {
     for (const auto& base : library) {
       if (!starts_at_a_time(base)) continue;
       EffectCandidate variant = base;
@@ -381,12 +386,45 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     }
   }
 
+  // The held-out segments that reach an onset and the nominal model's errors on them, kept
+  // per onset (every onset variant of the screening shares the change point's).
+  struct LaterHeldOut {
+    std::vector<Segment> segments;
+    std::vector<double> nominal_errors;
+  };
+  std::map<double, LaterHeldOut> later_by_onset;
+  const auto later_held_out = [&](double onset_s) -> const LaterHeldOut& {
+    auto [it, inserted] = later_by_onset.try_emplace(onset_s);
+    if (inserted) {
+      for (const Segment& seg : d.plan.held_out) {
+        if (record.t[seg.begin + seg.length - 1] >= onset_s) it->second.segments.push_back(seg);
+      }
+      it->second.nominal_errors =
+          segment_errors(predictor, nominal.parameters, it->second.segments);
+    }
+    return it->second;
+  };
   const auto score = [&](const EffectCandidate& candidate, FitResult fit) {
     RankedEffect r;
     r.effect = candidate.effect;
     const auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
     r.score = 1.0 - std::exp(-mean_log_ratio(nominal_errors, errors));
     r.significance = std::max(paired_t(nominal_errors, errors), trimmed_t(nominal_errors, errors));
+    // An effect that starts inside the capture can gain only on the segments that reach its
+    // onset: over all of them, the earlier ones' zero gains dilute the paired t and the
+    // trimmed t cuts the later ones' gains away as outliers (811067: a droop from 139.6 s of
+    // 180 scored 0.19 at t 1.95, `unexplained`). Its evidence is also taken over every
+    // held-out segment that reaches the onset (not only the spread `held_out_used` keeps: a
+    // late onset leaves few of those); the score, a mean over every segment used, still
+    // counts any loss before the onset.
+    if (candidate.onset_s > 0.0) {
+      const auto& later = later_held_out(candidate.onset_s);
+      if (later.segments.size() >= settings.min_onset_segments) {
+        const auto later_errors = segment_errors(predictor, fit.parameters, later.segments);
+        r.significance = std::max({r.significance, paired_t(later.nominal_errors, later_errors),
+                                   trimmed_t(later.nominal_errors, later_errors)});
+      }
+    }
     r.plausible = candidate.plausible(fit.values);
     r.params = named_values(candidate, fit);
     r.fit = std::move(fit);

@@ -120,6 +120,16 @@ struct DiagnosisSettings {
   // tried from it on too; a named one's onset is then searched within +-onset_search_s of it in
   // steps of onset_step_s.
   double min_change_statistic = 5.0;
+  // ... or at least the second with a step of at least the first (natural log of the mean
+  // square error's ratio): an effect that starts late leaves few segments after it, whose t
+  // stays small however large the step (811067: a droop 40 s before the end, t 4.87, its error
+  // e^2.9 times as large after it). The 40 healthy rigs of docs/model-check.md split at t up
+  // to 4.95 with steps up to 0.56 (a hunting rig 1.31).
+  double large_change_step = 1.5;
+  double min_large_change_statistic = 4.0;
+  // An onset variant's held-out evidence is also taken over every held-out segment that
+  // reaches its onset, when there are at least this many (diagnosis.cpp's score).
+  std::size_t min_onset_segments = 8;
   std::size_t onset_candidates = 4;   // leading screened effects, one variant each ...
   std::size_t change_candidates = 3;  // ... of which these have their per-segment gain split
   // The split is also sought among the segments in which the piston moves (change_point.hpp's
@@ -182,7 +192,7 @@ struct Diagnosis {
   std::string cause = "none";
   std::vector<NamedValue> params;  // the cause's parameters with standard errors
   // The best split of the capture for an effect that starts inside it (onset variants are
-  // tried when its statistic reaches DiagnosisSettings::min_change_statistic).
+  // tried when it passes DiagnosisSettings::min_change_statistic, or the large step's).
   std::optional<ChangePoint> change_point;
   Calibration calibrated;  // of the reported model (the cause's fit, or nominal)
   Calibration calibrated_errors;

@@ -61,9 +61,11 @@ RigCheck check_rig(const MeasuredRecord& record, std::span<const Segment> fittin
   constexpr auto half = static_cast<std::size_t>(PistonVelocity::kLineHalfWindow);
   const std::size_t n = record.size();
   for (std::size_t k = half; k + half < n; ++k) {
-    bool valid = true;
-    for (std::size_t j = k - half; j <= k + half; ++j) valid = valid && record.valid[j];
-    if (!valid) continue;
+    const auto window = record.valid.begin() + static_cast<std::ptrdiff_t>(k - half);
+    if (!std::all_of(window, window + static_cast<std::ptrdiff_t>(2 * half + 1),
+                     [](bool valid) { return valid; })) {
+      continue;
+    }
     samples.push_back({std::abs(PistonVelocity::line_at(record.x, k, record.dt)),
                        std::abs(record.u[k]), record.p1[k] + record.p2[k]});
   }

@@ -317,6 +317,52 @@ TEST(Calibration, ReusedEvaluationsGiveTheFitOfFreshOnes) {
   EXPECT_EQ(reused.evaluations, simulated.evaluations);
 }
 
+// A Jacobian column of an effect that starts inside the capture simulates only the segments
+// that reach its onset: the fit must be the one that simulates every segment for every column,
+// bit for bit, for a joint candidate whose parts act from the start (a friction) and from an
+// onset (a leak from 12 s of 24), with errors asked for (the optimum's Jacobian too).
+TEST(Calibration, SkippingSegmentsBeforeAnOnsetGivesTheFitOfSimulatingThemAll) {
+  const auto seed = test::model_test_seed(
+      "Calibration.SkippingSegmentsBeforeAnOnsetGivesTheFitOfSimulatingThemAll");
+  const SyntheticCase c = draw_case(seed, "internal_leakage", {24.0});
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const SegmentPredictor predictor(record);
+  const auto segments = spread(split_record(record).fitting, 8);
+  const auto library = effect_library(0.0);
+  const auto find = [&](const std::string& name) {
+    const auto it = std::find_if(library.begin(), library.end(),
+                                 [&](const EffectCandidate& e) { return e.effect == name; });
+    EXPECT_NE(it, library.end()) << name;
+    return *it;
+  };
+  EffectCandidate leak = find("internal_leakage");
+  leak.onset_s = 12.0;
+  const EffectCandidate joint = combine({find("coulomb_friction"), leak});
+  std::size_t before = 0, after = 0;
+  for (const auto& seg : segments) {
+    (record.t[seg.begin + seg.length - 1] < leak.onset_s ? before : after) += 1;
+  }
+  std::printf("  seed %llu: %zu segments end before the onset, %zu reach it\n",
+              static_cast<unsigned long long>(seed), before, after);
+  ASSERT_GT(before, 0u) << "no segment is skipped: the case tests nothing";
+  ASSERT_GT(after, 0u);
+  FitSettings settings;
+  settings.uncertainties = true;
+  settings.stated = Calibration::of(c.scenario.params);
+  FitSettings every = settings;
+  every.skip_segments_before_onset = false;
+  const FitResult skipped = fit_model(predictor, segments, &joint, settings.stated, settings);
+  const FitResult simulated = fit_model(predictor, segments, &joint, settings.stated, every);
+  EXPECT_EQ(skipped.parameters.calibration.beta, simulated.parameters.calibration.beta);
+  EXPECT_EQ(skipped.parameters.calibration.Kv, simulated.parameters.calibration.Kv);
+  EXPECT_EQ(skipped.parameters.calibration.m, simulated.parameters.calibration.m);
+  EXPECT_EQ(skipped.parameters.calibration.b, simulated.parameters.calibration.b);
+  EXPECT_EQ(skipped.values, simulated.values);
+  EXPECT_EQ(skipped.value_errors, simulated.value_errors);
+  EXPECT_EQ(skipped.cost, simulated.cost);
+  EXPECT_EQ(skipped.evaluations, simulated.evaluations);
+}
+
 // The predictor keeps the spool positions of its last few spool laws: residuals from a kept
 // run must be those of a predictor that has kept nothing, also after the laws kept have been
 // replaced (more laws than it keeps, in turn, twice) and with a law switching at an onset.
