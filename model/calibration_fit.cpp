@@ -79,6 +79,19 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
     }
     if (candidate && skip_segments_before_onset) collect_late(*candidate, starts_late_);
     starts_late_.resize(candidate ? candidate->parameters.size() : 0, false);
+    if (std::find(starts_late_.begin(), starts_late_.end(), true) != starts_late_.end()) {
+      // The onset is the candidate's, the same at every point of the solver.
+      const double onset_s = model(start_point()).onset_s;
+      std::size_t offset = 0;
+      for (const auto& seg : segments_) {
+        if (predictor_.reaches(seg, onset_s)) {
+          later_.push_back(seg);
+          later_offsets_.push_back(offset);
+        }
+        offset += SegmentPredictor::residual_count({&seg, 1});
+      }
+      later_residuals_.resize(SegmentPredictor::residual_count(later_));
+    }
   }
 
   int first_effect() const { return first_effect_; }
@@ -172,24 +185,11 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   // spends 40 % of its time in such fits).
   void shifted_after_onset(const InputType& theta, const ValueType& base,
                            ValueType& shifted) const {
-    const ModelParameters p = model(theta);
-    const auto& t = predictor_.record().t;
     shifted = base;
-    later_.clear();
-    later_offsets_.clear();
-    std::size_t offset = 0;
-    for (const auto& seg : segments_) {
-      if (seg.length > 0 && t[seg.begin + seg.length - 1] >= p.onset_s) {
-        later_.push_back(seg);
-        later_offsets_.push_back(offset);
-      }
-      offset += 3 * (seg.length - 1);
-    }
-    later_residuals_.resize(SegmentPredictor::residual_count(later_));
-    predictor_.residuals(p, later_, later_residuals_);
+    predictor_.residuals(model(theta), later_, later_residuals_);
     std::size_t from = 0;
     for (std::size_t i = 0; i < later_.size(); ++i) {
-      const std::size_t count = 3 * (later_[i].length - 1);
+      const std::size_t count = SegmentPredictor::residual_count({&later_[i], 1});
       std::copy_n(later_residuals_.begin() + static_cast<std::ptrdiff_t>(from), count,
                   shifted.data() + later_offsets_[i]);
       from += count;
@@ -214,9 +214,10 @@ class SegmentFitProblem : public Eigen::DenseFunctor<double> {
   int first_effect_ = 0;
   bool reuse_evaluations_ = true;
   std::vector<bool> starts_late_;  // per effect parameter (collect_late)
-  // shifted_after_onset's segments after the onset, their offsets in the residuals, and theirs.
-  mutable std::vector<Segment> later_;
-  mutable std::vector<std::size_t> later_offsets_;
+  // The segments that reach the onset (when a parameter starts late), their offsets in the
+  // residuals, and shifted_after_onset's room for their residuals.
+  std::vector<Segment> later_;
+  std::vector<std::size_t> later_offsets_;
   mutable std::vector<double> later_residuals_;
   // The accepted point and the rejected trials after it.
   mutable RecentResults<InputType, ValueType, 4> recent_;

@@ -397,7 +397,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     auto [it, inserted] = later_by_onset.try_emplace(onset_s);
     if (inserted) {
       for (const Segment& seg : d.plan.held_out) {
-        if (record.t[seg.begin + seg.length - 1] >= onset_s) it->second.segments.push_back(seg);
+        if (predictor.reaches(seg, onset_s)) it->second.segments.push_back(seg);
       }
       it->second.nominal_errors =
           segment_errors(predictor, nominal.parameters, it->second.segments);

@@ -78,6 +78,12 @@ class SegmentPredictor {
                Prediction& out) const;
   // Number of residuals residuals() writes for these segments.
   static std::size_t residual_count(std::span<const Segment> segments);
+  // Does `segment` reach `onset_s`, i.e. run any of its samples on the model from an onset
+  // there (run() switches at the first sample at or after it)? One that does not has the
+  // residuals of the model before the onset, whatever the effect that starts.
+  bool reaches(const Segment& segment, double onset_s) const {
+    return segment.length > 0 && record_.t[segment.begin + segment.length - 1] >= onset_s;
+  }
   // (prediction - measurement) / channel scale for x, p1, p2 at every sample after each
   // segment's first; 0 where a sample is missing. Huge values when the model blows up.
   void residuals(const ModelParameters& parameters, std::span<const Segment> segments,

@@ -340,7 +340,7 @@ TEST(Calibration, SkippingSegmentsBeforeAnOnsetGivesTheFitOfSimulatingThemAll) {
   const EffectCandidate joint = combine({find("coulomb_friction"), leak});
   std::size_t before = 0, after = 0;
   for (const auto& seg : segments) {
-    (record.t[seg.begin + seg.length - 1] < leak.onset_s ? before : after) += 1;
+    (predictor.reaches(seg, leak.onset_s) ? after : before) += 1;
   }
   std::printf("  seed %llu: %zu segments end before the onset, %zu reach it\n",
               static_cast<unsigned long long>(seed), before, after);
