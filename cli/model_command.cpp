@@ -103,6 +103,10 @@ int run_evaluate_cases(int argc, char** argv) {
               "paper (MODEL.md's rig) or other (rigs drawn from MODEL.md's 'Other rigs' "
               "ranges, each told its description; classes misstated and onset as well)",
               "paper")
+      .flag("programs",
+            "each capture runs a random test program (MODEL.md 'Test programs': 3-8 phases of "
+            "steps, holds, sines, sweeps and triangles, shortened alike to fit the capture, "
+            "amplitudes as the rig's steps) instead of the paper's steps")
       .option("out", "DIR", "output directory", std::nullopt, true)
       .flag("keep-captures",
             "also write each case's capture (OUT/case-SEED.csv) and the rig it was told "
@@ -122,6 +126,7 @@ int run_evaluate_cases(int argc, char** argv) {
     throw UsageError(fmt::format("option '--rigs': '{}' is neither paper nor other", rigs));
   }
   case_settings.other_rig = rigs == "other";
+  case_settings.program = args.flag_set("programs");
   std::vector<std::string> kinds;
   const std::string list = args.get("classes");
   for (std::size_t begin = 0; begin <= list.size();) {
@@ -167,6 +172,7 @@ int run_evaluate_cases(int argc, char** argv) {
           c.rig, c.misstated.empty() ? "-" : c.misstated, c.misstated_true, c.misstated_stated,
           findings.empty() ? " nothing" : findings, c.onset_true, c.onset_estimate);
     }
+    if (!c.program.empty()) fmt::print("  program {}\n", c.program);
     std::fflush(stdout);
   }
   write_text(dir + "/cases.csv", summary.csv());
@@ -185,7 +191,7 @@ int run_model(int argc, char** argv) {
       "                           [--rig RIG.yaml | --config CONFIG.yaml --actuator NAME]\n"
       "                           [--report DIR]\n"
       "       leakmon model evaluate --out DIR [--cases N] [--seed S] [--duration SECONDS]\n"
-      "                              [--classes LIST] [--rigs paper|other]\n";
+      "                              [--classes LIST] [--rigs paper|other] [--programs]\n";
   if (argc < 2) throw UsageError(std::string(usage));
   const std::string_view action = argv[1];
   if (action == "-h" || action == "--help") {

@@ -4,7 +4,7 @@
 // predictor uses its expectation, w = 0. What it adds to the simulator's Plant is what fitting
 // needs: the calibratable parameters and every effect parameter settable per evaluation, a
 // single lagging-transducer state, an adaptive sub-step count and, where even that cannot
-// resolve Coulomb friction's tanh(v / 1e-3), a widened sticking band.
+// resolve Coulomb friction's tanh(v / 1e-3), sticking with the velocity slaved to the force.
 #pragma once
 
 #include "model/model_parameters.hpp"
@@ -43,7 +43,8 @@ class ActuatorModel {
   // Integration sub-steps per sample interval: enough for RK4 to stay stable, since Coulomb
   // friction's tanh(v / 1e-3) is a very stiff damper near v = 0.
   int substeps(double dt) const;
-  // The tanh velocity scale used with sub-step h: 1e-3, widened where h cannot resolve it.
+  // The tanh velocity scale sub-step h resolves: 1e-3, or wider where h cannot (then a
+  // positive F_C sticks instead, advance(); a fit's negative trial F_C takes the wider band).
   double friction_velocity(double h) const;
 
   // Advances `state` from t0 over dt with the valve command u held (zero-order hold). w is the
@@ -65,15 +66,31 @@ class ActuatorModel {
  private:
   // The largest eigenvalue magnitude substeps() resolves: fixed by the coefficients, so it is
   // worked out once rather than on every sample interval of every segment.
-  double fastest_rate() const;
+  double fastest_rate(bool with_friction) const;
+  static int substeps_at_rate(double rate, double dt);
   ActuatorState derivative(const sim::ActuatorCoefficients& c, const ActuatorState& s,
                            double spool_in, double w, double t) const;
+  template <bool kStuck>
+  ActuatorState rate(const sim::ActuatorCoefficients& c, const ActuatorState& s, double spool_in,
+                     double w, double t) const;
+  template <bool kStuck>
+  void rk4_step(ActuatorState& state, const sim::ActuatorCoefficients& c, double spool_in, double t,
+                double h, double w) const;
+  void advance_sticking(ActuatorState& state, double spool_in, double t0, double h, int n, double w,
+                        const sim::ActuatorCoefficients& c) const;
+  [[gnu::always_inline]] static double stick_ratio(const sim::ActuatorCoefficients& c,
+                                                   const ActuatorState& s);
+  [[gnu::always_inline]] static double sticking_velocity(const sim::ActuatorCoefficients& c,
+                                                         double ratio);
+  // Beyond this share of F_C the force breaks the piston free (tanh^-1 of it: 3.8 bands).
+  static constexpr double kMaxStickRatio = 0.999;
 
   ModelParameters parameters_;
   sim::Parameters rig_;
   sim::ActuatorCoefficients c_;
   bool lagging_ = false;
   double fastest_rate_ = 0.0;
+  double fastest_rate_without_friction_ = 0.0;
   sim::Oil oil_ = sim::Oil::standard();
 };
 

@@ -74,6 +74,10 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
   const auto& rig = c.scenario.params;
   out.rig = fmt::format("D={:.0f}mm ps={:.1f}MPa K_s={:.0f}kN/m m={:.3g}kg Kv={:.3g} tau={:.3g}ms",
                         rig.D * 1e3, rig.ps * 1e-6, rig.K_s * 1e-3, rig.m, rig.Kv, rig.tau * 1e3);
+  for (const auto& phase : c.scenario.program) {
+    out.program += fmt::format("{}{} {:.0f}s", out.program.empty() ? "" : ";", phase.notation(),
+                               phase.duration_s);
+  }
   out.misstated = c.misstated;
   out.misstated_true = c.misstated_true;
   out.misstated_stated = c.misstated_stated;
@@ -118,7 +122,7 @@ std::string EvaluationSummary::csv() const {
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
       "nrmse_after,seconds,leading,leading_score,leading_significance,line_z,nrmse_floor,"
       "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate,rig,misstated,"
-      "misstated_true,misstated_stated,rig_findings,onset_true,onset_estimate\n";
+      "misstated_true,misstated_stated,rig_findings,onset_true,onset_estimate,program\n";
   for (const auto& c : cases) {
     std::string findings;
     for (const auto& f : c.rig_findings) {
@@ -126,12 +130,12 @@ std::string EvaluationSummary::csv() const {
     }
     out += fmt::format(
         "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{},"
-        "{},{:.6g},{:.4f},{:.6g},{},{},{:.6g},{:.6g},{},{:.3f},{:.3f}\n",
+        "{},{:.6g},{:.4f},{:.6g},{},{},{:.6g},{:.6g},{},{:.3f},{:.3f},{}\n",
         c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z,
         c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps, c.kind, c.nrmse_true,
         c.achieved, c.visc_estimate, c.rig, c.misstated, c.misstated_true, c.misstated_stated,
-        findings, c.onset_true, c.onset_estimate);
+        findings, c.onset_true, c.onset_estimate, c.program);
   }
   return out;
 }

@@ -33,6 +33,7 @@ class Draw {
 // A stream of the case's seed for the other rig, apart from the draws below (so that the
 // paper's cases draw exactly what they drew before other rigs existed).
 constexpr std::uint64_t kOtherRigStream = 0x6f746865722d7267ULL;  // "other-rg"
+constexpr std::uint64_t kProgramStream = 0x70726f6772616d73ULL;   // "programs"
 
 }  // namespace
 
@@ -41,6 +42,38 @@ const std::vector<Misstatement>& misstatements() {
                                                  {"load_stiffness", 0.40, 0.80}};
   return list;
 }
+
+namespace {
+
+// A test program (MODEL.md "Test programs") in place of the steps, drawn from its own stream so
+// that the rig and its effects are those of the same seed without a program. Its 3-8 phases
+// are shortened alike so that every one of them runs within the capture (MODEL.md's phases last
+// minutes), positions and amplitudes scaled as the rig's steps are (another rig's steps are
+// smaller where its valve cannot make the paper's), and drawn again while the rig cannot run it
+// (sim::check_viability; after kProgramDraws tries at half the amplitudes, and so on).
+std::vector<sim::Phase> capture_program(std::uint64_t seed, const sim::Scenario& on_rig) {
+  constexpr int kProgramDraws = 6;
+  std::mt19937_64 rng(seed ^ kProgramStream);
+  double scale = on_rig.reference.amp_max / sim::ReferenceSettings{}.amp_max;
+  sim::Scenario trial = on_rig;
+  for (int attempt = 1;; ++attempt) {
+    int no_leak_phase = -1;
+    std::vector<sim::Phase> program = sim::draw_program(rng, 1.0, std::nullopt, no_leak_phase);
+    const double shorten = on_rig.duration_s / sim::program_seconds(program);
+    for (auto& phase : program) {
+      phase.duration_s *= shorten;
+      phase.X *= scale;
+      phase.A *= scale;
+    }
+    trial.program = program;
+    if (attempt >= 4 * kProgramDraws || sim::check_viability(trial, trial.duration_s).ok) {
+      return program;
+    }
+    if (attempt % kProgramDraws == 0) scale *= 0.5;
+  }
+}
+
+}  // namespace
 
 SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
                         const CaseSettings& settings) {
@@ -181,6 +214,7 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
     s.change = sim::EffectChange{c.onset_s, e};
     e = sim::Effects{};
   }
+  if (settings.program) c.scenario.program = capture_program(seed, s);
   return c;
 }
 

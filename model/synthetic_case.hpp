@@ -53,6 +53,8 @@ struct CaseSettings {
   std::string misstate = "";
   // The effects appear inside the capture, at 20-80 % of its length (Scenario::change).
   bool onset = false;
+  // A random test program of MODEL.md's phases instead of the paper's steps (capture_program()).
+  bool program = false;
 };
 
 // The keys a `misstated` case may state wrong, and how far off (relative, either direction).

@@ -122,4 +122,77 @@ double ProgramReference::at(double t) noexcept {
   return phase_reference(phase, t - starts_[current_], lengths_[current_]);
 }
 
+namespace {
+
+double uniform_in(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+}  // namespace
+
+// MODEL.md "Test programs": a phase of `kind` with the table's typical values and length (times
+// `time_scale`), each drawn uniformly in its range.
+Phase draw_phase(std::mt19937_64& rng, PhaseKind kind, double time_scale) {
+  Phase phase;
+  phase.kind = kind;
+  double minutes_lo = 2.0, minutes_hi = 10.0;
+  switch (kind) {
+    case PhaseKind::steps:
+      break;
+    case PhaseKind::hold:
+      phase.X = uniform_in(rng, -0.05, 0.05);
+      minutes_lo = 1.0;
+      break;
+    case PhaseKind::sine:
+      phase.F = uniform_in(rng, 0.2, 3.0);
+      phase.A = uniform_in(rng, 0.005, 0.04);
+      break;
+    case PhaseKind::sweep:
+      phase.F0 = uniform_in(rng, 0.1, 0.5);
+      phase.F1 = uniform_in(rng, 1.5, 4.0);
+      phase.A = uniform_in(rng, 0.005, 0.03);
+      minutes_lo = 1.0;
+      minutes_hi = 5.0;
+      break;
+    case PhaseKind::triangle:
+      phase.P = uniform_in(rng, 1.0, 8.0);
+      phase.A = uniform_in(rng, 0.01, 0.045);
+      break;
+  }
+  phase.duration_s = 60.0 * uniform_in(rng, minutes_lo, minutes_hi) * time_scale;
+  return phase;
+}
+
+// 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
+// the others with another kind. With `leak_kind` one phase after the first and before the last
+// (learning happens in the first; a leak in a hold is judged in the next) takes that kind; its
+// index goes to `leak_phase`.
+std::vector<Phase> draw_program(std::mt19937_64& rng, double time_scale,
+                                std::optional<PhaseKind> leak_kind, int& leak_phase) {
+  auto any_kind = [&] {
+    return kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
+  };
+  const int n = std::uniform_int_distribution<int>(3, 8)(rng);
+  std::vector<PhaseKind> kinds;
+  for (int i = 0; i < n; ++i) kinds.push_back(any_kind());
+  const PhaseKind not_hold[] = {PhaseKind::steps, PhaseKind::sine, PhaseKind::sweep,
+                                PhaseKind::triangle};
+  kinds[0] =
+      rng() % 2 == 0 ? PhaseKind::hold : not_hold[std::uniform_int_distribution<int>(0, 3)(rng)];
+  leak_phase = -1;
+  if (leak_kind) {
+    leak_phase = std::uniform_int_distribution<int>(1, n - 2)(rng);
+    kinds[static_cast<std::size_t>(leak_phase)] = *leak_kind;
+  }
+  std::vector<Phase> program;
+  for (const PhaseKind kind : kinds) program.push_back(draw_phase(rng, kind, time_scale));
+  return program;
+}
+
+double program_seconds(const std::vector<Phase>& program) {
+  double total = 0.0;
+  for (const Phase& phase : program) total += phase.duration_s;
+  return total;
+}
+
 }  // namespace leakmon::sim

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <random>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,6 +48,16 @@ struct Phase {
 //   sweep:    A sin(2 pi (F0 t' + (F1 - F0) t'^2 / (2 T)))
 //   triangle: constant-speed ramps between +-A with period P, rising from 0 at t' = 0
 double phase_reference(const Phase& phase, double t_in_phase, double length) noexcept;
+
+// MODEL.md "Test programs": a phase of `kind` with the table's typical values and length (times
+// `time_scale`), each drawn uniformly in its range.
+Phase draw_phase(std::mt19937_64& rng, PhaseKind kind, double time_scale);
+// 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
+// the others with another kind. With `leak_kind` one phase after the first and before the last
+// takes that kind; its index goes to `leak_phase` (-1 without).
+std::vector<Phase> draw_program(std::mt19937_64& rng, double time_scale,
+                                std::optional<PhaseKind> leak_kind, int& leak_phase);
+double program_seconds(const std::vector<Phase>& program);
 
 // Where the phases of a program sit in a run of `run_seconds`: phase i covers
 // [start(i), end(i)); the last one ends with the run. Phases that start at or after the run's end

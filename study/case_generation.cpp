@@ -69,71 +69,6 @@ void draw_sensor_fault(std::mt19937_64& rng, int kind, double from, double to, R
   run.scenario.faults.push_back(fault);
 }
 
-// MODEL.md "Test programs": a phase of `kind` with the table's typical values and length (times
-// `time_scale`), each drawn uniformly in its range.
-sim::Phase draw_phase(std::mt19937_64& rng, sim::PhaseKind kind, double time_scale) {
-  sim::Phase phase;
-  phase.kind = kind;
-  double minutes_lo = 2.0, minutes_hi = 10.0;
-  switch (kind) {
-    case sim::PhaseKind::steps:
-      break;
-    case sim::PhaseKind::hold:
-      phase.X = uniform(rng, -0.05, 0.05);
-      minutes_lo = 1.0;
-      break;
-    case sim::PhaseKind::sine:
-      phase.F = uniform(rng, 0.2, 3.0);
-      phase.A = uniform(rng, 0.005, 0.04);
-      break;
-    case sim::PhaseKind::sweep:
-      phase.F0 = uniform(rng, 0.1, 0.5);
-      phase.F1 = uniform(rng, 1.5, 4.0);
-      phase.A = uniform(rng, 0.005, 0.03);
-      minutes_lo = 1.0;
-      minutes_hi = 5.0;
-      break;
-    case sim::PhaseKind::triangle:
-      phase.P = uniform(rng, 1.0, 8.0);
-      phase.A = uniform(rng, 0.01, 0.045);
-      break;
-  }
-  phase.duration_s = 60.0 * uniform(rng, minutes_lo, minutes_hi) * time_scale;
-  return phase;
-}
-
-// 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
-// the others with another kind. With `leak_kind` one phase after the first and before the last
-// (learning happens in the first; a leak in a hold is judged in the next) takes that kind; its
-// index goes to `leak_phase`.
-std::vector<sim::Phase> draw_program(std::mt19937_64& rng, double time_scale,
-                                     std::optional<sim::PhaseKind> leak_kind, int& leak_phase) {
-  auto any_kind = [&] {
-    return sim::kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
-  };
-  const int n = std::uniform_int_distribution<int>(3, 8)(rng);
-  std::vector<sim::PhaseKind> kinds;
-  for (int i = 0; i < n; ++i) kinds.push_back(any_kind());
-  const sim::PhaseKind not_hold[] = {sim::PhaseKind::steps, sim::PhaseKind::sine,
-                                     sim::PhaseKind::sweep, sim::PhaseKind::triangle};
-  kinds[0] = rng() % 2 == 0 ? sim::PhaseKind::hold
-                            : not_hold[std::uniform_int_distribution<int>(0, 3)(rng)];
-  leak_phase = -1;
-  if (leak_kind) {
-    leak_phase = std::uniform_int_distribution<int>(1, n - 2)(rng);
-    kinds[static_cast<std::size_t>(leak_phase)] = *leak_kind;
-  }
-  std::vector<sim::Phase> program;
-  for (const sim::PhaseKind kind : kinds) program.push_back(draw_phase(rng, kind, time_scale));
-  return program;
-}
-
-double program_seconds(const std::vector<sim::Phase>& program) {
-  double total = 0.0;
-  for (const sim::Phase& phase : program) total += phase.duration_s;
-  return total;
-}
-
 // Whether a leak in `phase` can be seen: not in a hold whose load |K_s X| / A stays below
 // kJudgeableLoad.
 bool judgeable(const sim::Phase& phase, const sim::Parameters& params) {
@@ -168,18 +103,18 @@ void apply_program(std::mt19937_64& rng, const EvaluationOptions& options, RunSp
                     : sim::kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
   }
   int j = -1;
-  s.program = draw_program(rng, options.time_scale, leak_kind, j);
-  s.duration_s = program_seconds(s.program);
+  s.program = sim::draw_program(rng, options.time_scale, leak_kind, j);
+  s.duration_s = sim::program_seconds(s.program);
   if (j >= 0) {
     const auto at = static_cast<std::size_t>(j);
-    auto spans = sim::phase_spans(s.program, program_seconds(s.program));
+    auto spans = sim::phase_spans(s.program, sim::program_seconds(s.program));
     const double length = spans[at].end - spans[at].start;
     const double lo =
         std::max(spans[at].start + std::min(10.0, 0.1 * length), run.monitor_from + 20.0);
     if (lo > spans[at].end - 10.0) {
       // A short phase right after learning: lengthened so the leak opens inside it.
       s.program[at].duration_s += lo - (spans[at].end - 10.0);
-      spans = sim::phase_spans(s.program, program_seconds(s.program));
+      spans = sim::phase_spans(s.program, sim::program_seconds(s.program));
     }
     const double hi = std::max(lo, spans[at].end - options.detect_within);
     run.onset = uniform(rng, lo, hi);

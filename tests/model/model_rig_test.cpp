@@ -137,6 +137,40 @@ TEST(RigCheck, ReadsTheSupplyColumnWhenThereIsOne) {
 // On the paper's rig every effect candidate is exactly as before; on another one the sizes
 // that scale with the rig follow it (a leak with the valve, friction with the force), and a
 // spool_lag is a spool slower than the rig's own.
+// `model evaluate --programs`: a random test program replaces the steps, on the rig and with
+// the effects the same seed draws without one (its own stream), every phase within the capture,
+// and one the rig runs (sim::check_viability: it tracks, does not saturate or hit a stop).
+TEST(ProgramCases, AProgramReplacesTheStepsOnTheSameRigWithTheSameEffects) {
+  const auto first =
+      test::model_test_seed("ProgramCases.AProgramReplacesTheStepsOnTheSameRigWithTheSameEffects");
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    CaseSettings steps = other_rig(60.0);
+    steps.onset = true;
+    CaseSettings programs = steps;
+    programs.program = true;
+    const SyntheticCase a = draw_case(first + i, "internal_leakage", steps);
+    const SyntheticCase b = draw_case(first + i, "internal_leakage", programs);
+    EXPECT_TRUE(a.scenario.program.empty());
+    EXPECT_EQ(a.scenario.params.D, b.scenario.params.D);
+    EXPECT_EQ(a.scenario.params.m, b.scenario.params.m);
+    EXPECT_EQ(a.scenario.params.K_s, b.scenario.params.K_s);
+    EXPECT_EQ(a.main_value, b.main_value);
+    EXPECT_EQ(a.onset_s, b.onset_s);
+    const auto& program = b.scenario.program;
+    ASSERT_GE(program.size(), 3u);
+    ASSERT_LE(program.size(), 8u);
+    double total = 0.0;
+    for (const auto& phase : program) {
+      total += phase.duration_s;
+      EXPECT_LE(std::abs(phase.A), 0.045 * b.scenario.reference.amp_max / 0.05 + 1e-12);
+      EXPECT_LE(std::abs(phase.X), b.scenario.reference.amp_max + 1e-12);
+    }
+    EXPECT_NEAR(total, 60.0, 1e-9);
+    const sim::Viability runs = sim::check_viability(b.scenario, 60.0);
+    EXPECT_TRUE(runs.ok) << "seed " << first + i << ": " << runs.reason;
+  }
+}
+
 TEST(EffectLibrary, SizesFollowTheRig) {
   const auto paper = effect_library(0.0, false, 0.002);
   const auto same = effect_library(0.0, false, 0.002, sim::Parameters{});
