@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include <Eigen/Dense>
+
 namespace leakmon::model {
 
 std::vector<Segment> segments_in_time_order(const SegmentPlan& plan) {
@@ -64,6 +66,87 @@ std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,
     const double t = se > 0.0 ? (after - before) / se : 0.0;
     if (!found || t > best.statistic) {
       best = {j, record.t[segments[j].begin], t, after - before};
+      found = true;
+    }
+  }
+  if (!found) return std::nullopt;
+  return best;
+}
+
+std::vector<std::vector<double>> segment_excitation(const MeasuredRecord& record,
+                                                    std::span<const Segment> segments) {
+  // Floors below any transducer's resolution keep a perfectly still segment's log finite.
+  constexpr double kRangeFloor = 1e-9;    // [m]
+  constexpr double kChangeFloor = 1e-12;  // [m per sample]
+  std::vector<std::vector<double>> out(2);
+  for (const auto& seg : segments) {
+    double low = record.x[seg.begin], high = low, change2 = 0.0;
+    for (std::size_t i = seg.begin + 1; i < seg.begin + seg.length; ++i) {
+      low = std::min(low, record.x[i]);
+      high = std::max(high, record.x[i]);
+      const double step = record.x[i] - record.x[i - 1];
+      change2 += step * step;
+    }
+    const double changes = static_cast<double>(std::max<std::size_t>(seg.length, 2) - 1);
+    out[0].push_back(std::log(std::max(high - low, kRangeFloor)));
+    out[1].push_back(std::log(std::max(std::sqrt(change2 / changes), kChangeFloor)));
+  }
+  return out;
+}
+
+std::optional<ChangePoint> find_change_point_beyond_excitation(
+    const MeasuredRecord& record, std::span<const Segment> segments,
+    std::span<const double> log_errors, const std::vector<std::vector<double>>& excitation,
+    std::size_t min_side) {
+  const std::size_t n = log_errors.size();
+  const std::size_t k = excitation.size() + 1;  // intercept and regressors
+  if (n < 2 * min_side || segments.size() != n || n <= k + 1) return std::nullopt;
+  for (const auto& regressor : excitation) {
+    if (regressor.size() != n) return std::nullopt;
+  }
+  // The regressors' Gram matrix and their products with y over every segment, and over the
+  // segments from j on (the step's column) as suffix sums: each split's normal equations are
+  // then assembled in O(k^2).
+  Eigen::MatrixXd X(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(k));
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto row = static_cast<Eigen::Index>(i);
+    X(row, 0) = 1.0;
+    for (std::size_t r = 0; r + 1 < k; ++r)
+      X(row, static_cast<Eigen::Index>(r + 1)) = excitation[r][i];
+    y(row) = log_errors[i];
+  }
+  const Eigen::MatrixXd gram = X.transpose() * X;
+  const Eigen::VectorXd xty = X.transpose() * y;
+  const double yty = y.squaredNorm();
+  std::vector<Eigen::VectorXd> tail_x(n + 1, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k)));
+  std::vector<double> tail_y(n + 1, 0.0);
+  for (std::size_t i = n; i-- > 0;) {
+    tail_x[i] = tail_x[i + 1] + X.row(static_cast<Eigen::Index>(i)).transpose();
+    tail_y[i] = tail_y[i + 1] + log_errors[i];
+  }
+  const auto size = static_cast<Eigen::Index>(k + 1);
+  Eigen::MatrixXd normal(size, size);
+  Eigen::VectorXd rhs(size);
+  normal.topLeftCorner(size - 1, size - 1) = gram;
+  rhs.head(size - 1) = xty;
+  ChangePoint best;
+  bool found = false;
+  for (std::size_t j = min_side; j + min_side <= n; ++j) {
+    normal.topRightCorner(size - 1, 1) = tail_x[j];
+    normal.bottomLeftCorner(1, size - 1) = tail_x[j].transpose();
+    normal(size - 1, size - 1) = static_cast<double>(n - j);
+    rhs(size - 1) = tail_y[j];
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(normal);
+    if (!lu.isInvertible()) continue;  // the step is a combination of the regressors here
+    const Eigen::MatrixXd inverse = lu.inverse();
+    const Eigen::VectorXd beta = inverse * rhs;
+    const double residual = std::max(yty - beta.dot(rhs), 0.0);
+    const double sigma2 = residual / static_cast<double>(n - k - 1);
+    const double variance = sigma2 * inverse(size - 1, size - 1);
+    const double t = variance > 0.0 ? beta(size - 1) / std::sqrt(variance) : 0.0;
+    if (!found || t > best.statistic) {
+      best = {j, record.t[segments[j].begin], t, beta(size - 1)};
       found = true;
     }
   }

@@ -41,4 +41,22 @@ std::optional<ChangePoint> find_change_point(const MeasuredRecord& record,
                                              std::span<const double> log_errors,
                                              std::size_t min_side = 8);
 
+// How much each segment excites the rig, as regressors of its error: the log of the position's
+// range (a hold's against a stroke) and of its rms sample-to-sample change (the same range
+// swept faster). Both from x, the one channel every capture has.
+std::vector<std::vector<double>> segment_excitation(const MeasuredRecord& record,
+                                                    std::span<const Segment> segments);
+
+// The split of `log_errors` with the excitation regressed out jointly: for each split j,
+// log_errors[i] = a + sum_k b_k excitation[k][i] + c [i >= j], and the split's statistic is
+// c's t. A test program's phases move the error with their excitation (a hold's is the
+// transducers' noise, a sweep's end its fastest motion) far more than an effect's onset does,
+// and the plain split lands at the phase change; an onset inside a phase is a step the
+// excitation does not explain (818208: a sensor lag from 84.5 s in a sine block, every plain
+// split at a sweep's fast end 175.5 s, this one at 84.5 s). `step` is c.
+std::optional<ChangePoint> find_change_point_beyond_excitation(
+    const MeasuredRecord& record, std::span<const Segment> segments,
+    std::span<const double> log_errors, const std::vector<std::vector<double>>& excitation,
+    std::size_t min_side = 8);
+
 }  // namespace leakmon::model

@@ -135,6 +135,10 @@ struct DiagnosisSettings {
   // The split is also sought among the segments in which the piston moves (change_point.hpp's
   // moving_segments, this share of the 90th percentile of the segments' position ranges).
   double moving_share = 0.25;
+  // Onsets tried: the strongest splits that suggest one (over every series above), at most
+  // this many, each at least the separation from the ones taken before it.
+  std::size_t onset_splits = 2;
+  double onset_split_separation_s = 8.0;
   double onset_search_s = 4.0;
   double onset_step_s = 0.05;
   // While the flat stretch of the summed errors reaches the search window's edge, the window is
@@ -168,6 +172,11 @@ struct NamedCause {
   std::string effect;  // an effect of the library, or "rig_parameter"
   std::vector<NamedValue> params;
   double onset_s = 0.0;  // > 0: the effect starts at this capture time (FORMATS.md `onset_s`)
+  // The onsets the data fit alike (the summed error flat across them): an effect that shows
+  // only in motion and starts during a hold is known to lie somewhere in that hold, and onset_s
+  // is the stretch's middle. Equal to onset_s, or within a search step of it, when the onset
+  // shows at once.
+  double onset_earliest_s = 0.0, onset_latest_s = 0.0;
 };
 
 // A parameter fitted on the first and on the last third of the capture.
@@ -194,7 +203,8 @@ struct Diagnosis {
   // The best split of the capture for an effect that starts inside it (onset variants are
   // tried when it passes DiagnosisSettings::min_change_statistic, or the large step's).
   std::optional<ChangePoint> change_point;
-  Calibration calibrated;  // of the reported model (the cause's fit, or nominal)
+  std::vector<ChangePoint> onsets_tried;  // the splits whose onset variants were fitted
+  Calibration calibrated;                 // of the reported model (the cause's fit, or nominal)
   Calibration calibrated_errors;
   std::vector<RankedEffect> ranking;  // every effect, best first
   double nrmse_before = 0.0;          // held-out, calibrated nominal model

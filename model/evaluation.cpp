@@ -69,6 +69,8 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
         if (p.name == c.main_parameter) out.estimate = p.value;
       }
       out.onset_estimate = cause.onset_s;
+      out.onset_earliest = cause.onset_earliest_s;
+      out.onset_latest = cause.onset_latest_s;
     }
   }
   const auto& rig = c.scenario.params;
@@ -122,7 +124,8 @@ std::string EvaluationSummary::csv() const {
       "seed,truth,named,main_parameter,true_value,estimate,nrmse_before,"
       "nrmse_after,seconds,leading,leading_score,leading_significance,line_z,nrmse_floor,"
       "causes,drifts,at_bound,steps,kind,nrmse_true,achieved,visc_estimate,rig,misstated,"
-      "misstated_true,misstated_stated,rig_findings,onset_true,onset_estimate,program\n";
+      "misstated_true,misstated_stated,rig_findings,onset_true,onset_estimate,program,onset_"
+      "earliest,onset_latest\n";
   for (const auto& c : cases) {
     std::string findings;
     for (const auto& f : c.rig_findings) {
@@ -130,12 +133,12 @@ std::string EvaluationSummary::csv() const {
     }
     out += fmt::format(
         "{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.3f},{},{:.5f},{:.3f},{:.3f},{:.6g},{},{},{},{},"
-        "{},{:.6g},{:.4f},{:.6g},{},{},{:.6g},{:.6g},{},{:.3f},{:.3f},{}\n",
+        "{},{:.6g},{:.4f},{:.6g},{},{},{:.6g},{:.6g},{},{:.3f},{:.3f},{},{:.3f},{:.3f}\n",
         c.seed, c.truth, c.named, c.main_parameter, c.true_value, c.estimate, c.nrmse_before,
         c.nrmse_after, c.seconds, c.leading, c.leading_score, c.leading_significance, c.line_z,
         c.nrmse_floor, c.causes, c.drifts ? 1 : 0, c.at_bound, c.steps, c.kind, c.nrmse_true,
         c.achieved, c.visc_estimate, c.rig, c.misstated, c.misstated_true, c.misstated_stated,
-        findings, c.onset_true, c.onset_estimate, c.program);
+        findings, c.onset_true, c.onset_estimate, c.program, c.onset_earliest, c.onset_latest);
   }
   return out;
 }
@@ -355,6 +358,9 @@ std::string EvaluationSummary::targets_markdown() const {
           named && std::abs(c.onset_estimate - c.onset_true) <= 2.0);
       counts["onset: the effect alone, onset within 2 s"].add(
           c.only_truth_named() && std::abs(c.onset_estimate - c.onset_true) <= 2.0);
+      // An effect that shows only in motion and starts in a hold is placed within the hold.
+      counts["onset: named, the true onset within the stretch reported (+-2 s)"].add(
+          named && c.onset_true >= c.onset_earliest - 2.0 && c.onset_true <= c.onset_latest + 2.0);
     }
     if (c.kind == "pair") {
       bool both = true;

@@ -45,6 +45,7 @@ struct CaseOutcome {
   double misstated_true = 0.0, misstated_stated = 0.0;
   std::vector<RigFinding> rig_findings;
   double onset_true = 0.0, onset_estimate = 0.0;
+  double onset_earliest = 0.0, onset_latest = 0.0;  // the stretch the data allow
   std::string program;  // the test program's phases in MODEL.md's notation, ';'-separated
   bool named_correctly() const { return truth == named; }
   // Exactly the true effects named: nothing else, no rig_parameter either.

@@ -52,6 +52,22 @@ std::string parameter_lines(const std::vector<NamedValue>& params) {
 
 // The rig the model check assumed (FORMATS.md: the report states it), what it checked and
 // what it changed from the stated values.
+// An onset the data place exactly, or only within a stretch (an effect that shows once the
+// piston moves, starting during a hold).
+std::string onset_phrase(const NamedCause& cause) {
+  if (cause.onset_s <= 0.0) return {};
+  if (cause.onset_latest_s - cause.onset_earliest_s > 1.0) {
+    return fmt::format(
+        ", starting between t = {:.2f} s and {:.2f} s (any onset in that stretch fits the data "
+        "alike: the effect shows only once the piston moves; {:.2f} s is its middle, marked on "
+        "the residual plot)",
+        cause.onset_earliest_s, cause.onset_latest_s, cause.onset_s);
+  }
+  return fmt::format(
+      ", starting at t = {:.2f} s (absent before: the residual plot marks the onset)",
+      cause.onset_s);
+}
+
 std::string rig_section(const Diagnosis& d) {
   const auto& c = d.rig_check;
   std::string out = "## The rig\n\n";
@@ -157,13 +173,9 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
         d.cause, d.causes.size() > 1 ? "them" : "it", d.nrmse_before, d.nrmse_after);
     for (const auto& cause : d.causes) {
       if (cause.effect == "rig_parameter") continue;  // in "The rig" below
-      out += fmt::format(
-          "**{}**{}\n\n| parameter | fitted value | standard error |\n|---|---|---|\n",
-          cause.effect,
-          cause.onset_s > 0.0 ? fmt::format(", starting at t = {:.2f} s (absent before: the "
-                                            "residual plot marks the onset)",
-                                            cause.onset_s)
-                              : std::string());
+      out +=
+          fmt::format("**{}**{}\n\n| parameter | fitted value | standard error |\n|---|---|---|\n",
+                      cause.effect, onset_phrase(cause));
       out += parameter_lines(cause.params) + "\n";
     }
   }

@@ -136,11 +136,13 @@ std::string diagnosis_json(const Diagnosis& d) {
   out += "  \"causes\": [";
   for (std::size_t i = 0; i < d.causes.size(); ++i) {
     const auto& cause = d.causes[i];
-    out += fmt::format("{}{{\"cause\": \"{}\", \"params\": {}, \"param_errors\": {}{}}}",
-                       i ? ", " : "", cause.effect, params_object(cause.params),
-                       errors_object(cause.params),
-                       cause.onset_s > 0.0 ? fmt::format(", \"onset_s\": {}", number(cause.onset_s))
-                                           : std::string());
+    out += fmt::format(
+        "{}{{\"cause\": \"{}\", \"params\": {}, \"param_errors\": {}{}}}", i ? ", " : "",
+        cause.effect, params_object(cause.params), errors_object(cause.params),
+        cause.onset_s > 0.0
+            ? fmt::format(", \"onset_s\": {}, \"onset_range_s\": [{}, {}]", number(cause.onset_s),
+                          number(cause.onset_earliest_s), number(cause.onset_latest_s))
+            : std::string());
   }
   out += "],\n";
   out += "  \"steps\": [";
@@ -160,6 +162,13 @@ std::string diagnosis_json(const Diagnosis& d) {
                     number(d.change_point->t_s), number(d.change_point->statistic),
                     number(d.change_point->step));
   }
+  out += "  \"onsets_tried\": [";
+  for (std::size_t i = 0; i < d.onsets_tried.size(); ++i) {
+    const auto& c = d.onsets_tried[i];
+    out += fmt::format("{}{{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}}", i ? ", " : "",
+                       number(c.t_s), number(c.statistic), number(c.step));
+  }
+  out += "],\n";
   out += fmt::format("  \"unexplained\": {},\n",
                      d.unexplained ? misfit_object(*d.unexplained) : "null");
   out += fmt::format("  \"at_bound\": {},\n", string_list(d.at_bound));

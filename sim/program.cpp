@@ -130,8 +130,6 @@ double uniform_in(std::mt19937_64& rng, double lo, double hi) {
 
 }  // namespace
 
-// MODEL.md "Test programs": a phase of `kind` with the table's typical values and length (times
-// `time_scale`), each drawn uniformly in its range.
 Phase draw_phase(std::mt19937_64& rng, PhaseKind kind, double time_scale) {
   Phase phase;
   phase.kind = kind;
@@ -163,10 +161,6 @@ Phase draw_phase(std::mt19937_64& rng, PhaseKind kind, double time_scale) {
   return phase;
 }
 
-// 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
-// the others with another kind. With `leak_kind` one phase after the first and before the last
-// (learning happens in the first; a leak in a hold is judged in the next) takes that kind; its
-// index goes to `leak_phase`.
 std::vector<Phase> draw_program(std::mt19937_64& rng, double time_scale,
                                 std::optional<PhaseKind> leak_kind, int& leak_phase) {
   auto any_kind = [&] {

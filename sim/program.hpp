@@ -54,7 +54,8 @@ double phase_reference(const Phase& phase, double t_in_phase, double length) noe
 Phase draw_phase(std::mt19937_64& rng, PhaseKind kind, double time_scale);
 // 3-8 phases of any kind; half of the programs start with a hold (a set-up, a leak-down test),
 // the others with another kind. With `leak_kind` one phase after the first and before the last
-// takes that kind; its index goes to `leak_phase` (-1 without).
+// (learning happens in the first; a leak in a hold is judged in the next) takes that kind; its
+// index goes to `leak_phase` (-1 without).
 std::vector<Phase> draw_program(std::mt19937_64& rng, double time_scale,
                                 std::optional<PhaseKind> leak_kind, int& leak_phase);
 double program_seconds(const std::vector<Phase>& program);
