@@ -168,8 +168,10 @@ TEST(ActuatorModel, ALightPistonUnderCoulombFrictionSticksAsTheSimulatorsDoes) {
 // and the effects that act on the piston or on one pressure reading (the regression's
 // friction, constant and pressure-change terms exist for them). A clean capture should give a
 // usable estimate with m within 10 % (within 5.5 % in 100 draws, but one clean draw in about
-// 400 is unusable, m 14.4 for a true 11.8: so at least one of the two clean ones must be
-// usable, and every usable one within 10 %). With an effect, any estimate that calls itself
+// 400 is unusable, m 14.4 for a true 11.8; and 2 of 304 usable clean draws lay beyond 10 %:
+// +11.7 %, and CI's seed 17223480221079556843, +18.7 %, m 10.90 for a true 9.19): so at least
+// one of the two clean ones must be usable and within 10 %, and every usable one within 20 %
+// (both beyond 10 %: about 1 run in 20000). With an effect, any estimate that calls itself
 // usable must have m within 20 % (seen: +11.6 % with a pressure-transducer offset, -15 to +12 %
 // under strong Coulomb friction, see the next test; the calibration refits beta and b around it,
 // and on these 24 s captures strong friction can make it unusable: diagnose() then fits m). b, only
@@ -180,7 +182,7 @@ TEST(ForceBalance, RecoversMassAndDampingFromMeasuredSignals) {
       test::model_test_seed("ForceBalance.RecoversMassAndDampingFromMeasuredSignals");
   const std::vector<std::string> effects = {"none",          "none",       "coulomb_friction",
                                             "sensor_offset", "sensor_lag", "internal_leakage"};
-  int clean_usable = 0;
+  int clean_usable = 0, clean_within_10 = 0;
   for (std::size_t i = 0; i < effects.size(); ++i) {
     const std::uint64_t seed = first_seed + i;
     const SyntheticCase c = draw_case(seed, effects[i], {24.0});
@@ -190,17 +192,20 @@ TEST(ForceBalance, RecoversMassAndDampingFromMeasuredSignals) {
     std::printf("  %-16s seed %llu: m %.2f (true %.2f)  b %.0f (true %.0f)%s\n", effects[i].c_str(),
                 static_cast<unsigned long long>(seed), fb.m, truth.m, fb.b, truth.b,
                 usable(fb) ? "" : "  (not usable)");
-    if (effects[i] == "none" && usable(fb)) ++clean_usable;
+    if (effects[i] == "none" && usable(fb)) {
+      ++clean_usable;
+      clean_within_10 += std::abs(fb.m - truth.m) <= 0.1 * truth.m;
+    }
     // A lagged pressure reading delays the measured force: the regression reads it as less
     // damping (b 63 % low seen in 50 draws) and now and then as more mass (m +35 % in one of
     // 60 draws, called usable). Under a sensor lag neither is a measurement, only a start
     // (docs/model-check.md, known weak spots).
     if (!usable(fb) || effects[i] == "sensor_lag") continue;
-    const double m_band = effects[i] == "none" ? 0.1 : 0.2;
-    EXPECT_NEAR(fb.m, truth.m, m_band * truth.m) << effects[i] << " seed " << seed;
+    EXPECT_NEAR(fb.m, truth.m, 0.2 * truth.m) << effects[i] << " seed " << seed;
     EXPECT_NEAR(fb.b, truth.b, 0.5 * truth.b) << effects[i] << " seed " << seed;
   }
   EXPECT_GE(clean_usable, 1) << "neither clean capture gave a usable force balance";
+  EXPECT_GE(clean_within_10, 1) << "neither clean capture gave m within 10 %";
 }
 
 // The friction regressor reads the sign of v off the +-3-sample line, not the cubic of the
