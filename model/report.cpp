@@ -50,8 +50,6 @@ std::string parameter_lines(const std::vector<NamedValue>& params) {
   return out;
 }
 
-// The rig the model check assumed (FORMATS.md: the report states it), what it checked and
-// what it changed from the stated values.
 // An onset the data place exactly, or only within a stretch (an effect that shows once the
 // piston moves, starting during a hold).
 std::string onset_phrase(const NamedCause& cause) {
@@ -68,6 +66,8 @@ std::string onset_phrase(const NamedCause& cause) {
       cause.onset_s);
 }
 
+// The rig the model check assumed (FORMATS.md: the report states it), what it checked and
+// what it changed from the stated values.
 std::string rig_section(const Diagnosis& d) {
   const auto& c = d.rig_check;
   std::string out = "## The rig\n\n";

@@ -126,6 +126,11 @@ std::string rig_object(const Diagnosis& d) {
       number(d.rig_score), number(d.rig_significance));
 }
 
+std::string change_point_object(const ChangePoint& c) {
+  return fmt::format("{{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}}", number(c.t_s),
+                     number(c.statistic), number(c.step));
+}
+
 }  // namespace
 
 std::string diagnosis_json(const Diagnosis& d) {
@@ -157,16 +162,11 @@ std::string diagnosis_json(const Diagnosis& d) {
   out += "],\n";
   out += fmt::format("  \"nrmse_floor\": {},\n", number(d.nrmse_floor));
   if (d.change_point) {
-    out +=
-        fmt::format("  \"change_point\": {{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}},\n",
-                    number(d.change_point->t_s), number(d.change_point->statistic),
-                    number(d.change_point->step));
+    out += fmt::format("  \"change_point\": {},\n", change_point_object(*d.change_point));
   }
   out += "  \"onsets_tried\": [";
   for (std::size_t i = 0; i < d.onsets_tried.size(); ++i) {
-    const auto& c = d.onsets_tried[i];
-    out += fmt::format("{}{{\"t_s\": {}, \"statistic\": {}, \"log_step\": {}}}", i ? ", " : "",
-                       number(c.t_s), number(c.statistic), number(c.step));
+    out += (i ? ", " : "") + change_point_object(d.onsets_tried[i]);
   }
   out += "],\n";
   out += fmt::format("  \"unexplained\": {},\n",

@@ -276,6 +276,20 @@ TEST(Onset, ANamedModelTradingItsCalibrationWithItsCauseDoesNotDrift) {
   }
 }
 
+CaseSettings program_onset_on_other_rig() {
+  CaseSettings s = onset_on_other_rig(180.0);
+  s.program = true;
+  return s;
+}
+
+void print_splits(const SyntheticCase& c, const Diagnosis& d) {
+  std::printf("  true onset %.2f s; strongest split %.2f s (t %.1f)\n", c.onset_s,
+              d.change_point->t_s, d.change_point->statistic);
+  for (const auto& split : d.onsets_tried) {
+    std::printf("  tried %.2f s (t %.1f)\n", split.t_s, split.statistic);
+  }
+}
+
 // Under a test program the nominal model's error follows the program, and its strongest split
 // can be a phase change instead of the effect. Fixed case 818214 of `model evaluate --programs
 // --rigs other --classes onset --seed 818200` (180 s): a 29 ms spool lag from 72.56 s on a 27 mm
@@ -284,16 +298,10 @@ TEST(Onset, ANamedModelTradingItsCalibrationWithItsCauseDoesNotDrift) {
 // tried: `unexplained`, the lag read as drift. Both are tried now; named alone with its onset
 // within 2 s, and the JSON lists the onsets tried.
 TEST(Onset, APhaseChangeOfTheProgramDoesNotHideTheOnset) {
-  CaseSettings settings = onset_on_other_rig(180.0);
-  settings.program = true;
-  const SyntheticCase c = draw_case(818214, "spool_lag", settings);
+  const SyntheticCase c = draw_case(818214, "spool_lag", program_onset_on_other_rig());
   const Diagnosis d = diagnose_case(c);
   ASSERT_TRUE(d.change_point.has_value());
-  std::printf("  true onset %.2f s; strongest split %.2f s (t %.1f)\n", c.onset_s,
-              d.change_point->t_s, d.change_point->statistic);
-  for (const auto& split : d.onsets_tried) {
-    std::printf("  tried %.2f s (t %.1f)\n", split.t_s, split.statistic);
-  }
+  print_splits(c, d);
   ASSERT_GT(std::abs(d.change_point->t_s - c.onset_s), 8.0)
       << "the strongest split is the onset: the case no longer tests a phase change";
   ASSERT_EQ(causes(d), "spool_lag");
@@ -310,16 +318,10 @@ TEST(Onset, APhaseChangeOfTheProgramDoesNotHideTheOnset) {
 // end (175.5 s, t 48); with the segments' excitation regressed out the errors split at 84.5 s
 // (t 21). Was `unexplained`; named alone with its onset within 2 s.
 TEST(Onset, AnOnsetInsideASineBlockIsFoundBeyondTheProgramsExcitation) {
-  CaseSettings settings = onset_on_other_rig(180.0);
-  settings.program = true;
-  const SyntheticCase c = draw_case(818208, "sensor_lag", settings);
+  const SyntheticCase c = draw_case(818208, "sensor_lag", program_onset_on_other_rig());
   const Diagnosis d = diagnose_case(c);
   ASSERT_TRUE(d.change_point.has_value());
-  std::printf("  true onset %.2f s; strongest split %.2f s (t %.1f)\n", c.onset_s,
-              d.change_point->t_s, d.change_point->statistic);
-  for (const auto& split : d.onsets_tried) {
-    std::printf("  tried %.2f s (t %.1f)\n", split.t_s, split.statistic);
-  }
+  print_splits(c, d);
   ASSERT_GT(std::abs(d.change_point->t_s - c.onset_s), 8.0)
       << "the strongest split is the onset: the case no longer tests the excitation";
   ASSERT_EQ(causes(d), "sensor_lag");
