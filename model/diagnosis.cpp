@@ -176,10 +176,24 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   d.rig = rig;
   d.plan = split_record(record, settings.split);
   if (d.plan.fitting.size() < 4 || d.plan.held_out.size() < 4) {
+    // Samples left out as clipping or a frozen transducer break segments as gaps do; a rig
+    // whose pressures ring past the transducers' range end every few tens of milliseconds
+    // leaves no whole segment, and the user must learn that it is the range, not the capture.
+    std::string left_out;
+    for (const auto& c : record.censored) {
+      if (c.reason == MeasuredRecord::Censored::Reason::spikes) continue;
+      left_out += fmt::format("{}{} {} on {} samples from {}",
+                              left_out.empty() ? "; left out as such: " : ", ", c.channel,
+                              c.reason == MeasuredRecord::Censored::Reason::range_end
+                                  ? fmt::format("at its range end ({:.4g} MPa)", c.value * 1e-6)
+                                  : std::string("holding one value"),
+                              c.samples, c.first);
+    }
     throw ModelCheckError(fmt::format(
-        "{}: only {} fitting and {} held-out segments without gaps; the model check needs at "
-        "least 4 of each",
-        record.source, d.plan.fitting.size(), d.plan.held_out.size()));
+        "{}: only {} fitting and {} held-out {} s segments without gaps or left-out samples{}; "
+        "the model check needs at least 4 of each",
+        record.source, d.plan.fitting.size(), d.plan.held_out.size(), settings.split.segment_s,
+        left_out));
   }
   d.fitting_used = spread(d.plan.fitting, settings.max_fitting_segments);
   d.held_out_used = spread(d.plan.held_out, settings.max_held_out_segments);

@@ -65,7 +65,11 @@ ForceBalance estimate_force_balance(const MeasuredRecord& record, std::span<cons
   }
   ForceBalance out;
   out.windows = rows.size();
-  if (rows.size() < 4 * static_cast<std::size_t>(unknowns)) return out;
+  if (rows.size() < 4 * static_cast<std::size_t>(unknowns)) {
+    // Too few windows to regress on: an unknown spring stays unknown (not the 0 it would read).
+    out.K_s = free_stiffness ? std::nan("") : rig.K_s;
+    return out;
+  }
   Eigen::MatrixXd a(static_cast<Eigen::Index>(rows.size()), unknowns);
   Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
   for (std::size_t i = 0; i < rows.size(); ++i) {

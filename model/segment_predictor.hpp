@@ -134,7 +134,7 @@ class SegmentPredictor {
   sim::Parameters rig_;
   ChannelScales scales_;
   std::vector<double> velocity_;   // of x, model/piston_velocity.hpp
-  std::vector<double> dp1_, dp2_;  // central differences of the pressure readings
+  std::vector<double> dp1_, dp2_;  // five-point slopes of the pressure readings
   // Everything spool_positions reads from its models (the spool's tau, u0 and u_max, then the
   // same before an onset and the onset's time; zeros without one): equal laws give equal
   // positions (compared bit for bit, recent_results.hpp).
