@@ -15,23 +15,6 @@
 namespace leakmon::model {
 namespace {
 
-// Mean squared scaled residual of each segment.
-std::vector<double> segment_errors(const SegmentPredictor& predictor,
-                                   const ModelParameters& parameters,
-                                   std::span<const Segment> segments) {
-  std::vector<double> r(SegmentPredictor::residual_count(segments));
-  predictor.residuals(parameters, segments, r);
-  std::vector<double> out;
-  std::size_t i = 0;
-  for (const auto& seg : segments) {
-    const std::size_t n = 3 * (seg.length - 1);
-    double sum = 0.0;
-    for (std::size_t j = 0; j < n; ++j, ++i) sum += r[i] * r[i];
-    out.push_back(sum / static_cast<double>(n));
-  }
-  return out;
-}
-
 // Mean over held-out segments of log(error before / error after): a geometric mean, so one
 // segment where an extension diverges cannot outweigh all the others (nor one lucky segment).
 double mean_log_ratio(const std::vector<double>& before, const std::vector<double>& after) {
@@ -808,15 +791,14 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
           const double end = begin + static_cast<double>(seg.length) * record.dt;
           if (end > from - 0.5 && begin < to + 0.5) near.push_back(seg);
         }
-        ModelParameters trial = current.parameters;
-        std::vector<std::pair<double, double>> sums;  // onset, summed error
+        std::vector<double> onsets;
         for (int i = 0; i < trials; ++i) {
-          trial.onset_s = from + (to - from) * i / (trials - 1);
-          if (trial.onset_s <= record.t.front() || trial.onset_s >= record.t.back()) continue;
-          double sum = 0.0;
-          for (double e : segment_errors(predictor, trial, near)) sum += e;
-          sums.emplace_back(trial.onset_s, sum);
+          const double onset = from + (to - from) * i / (trials - 1);
+          if (onset > record.t.front() && onset < record.t.back()) onsets.push_back(onset);
         }
+        const auto errors = summed_errors_at_onsets(predictor, current.parameters, near, onsets);
+        std::vector<std::pair<double, double>> sums;  // onset, summed error
+        for (std::size_t i = 0; i < onsets.size(); ++i) sums.emplace_back(onsets[i], errors[i]);
         return sums;
       };
       // The flat stretch around the smallest sum: [first, last] of `sums`. Flat against the
@@ -850,14 +832,20 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       std::vector<std::pair<double, double>> sums = summed_errors(from, to, trials);
       if (sums.empty()) continue;
       auto [first, last] = flat_stretch(sums);
-      for (std::size_t widened = 0; widened < settings.onset_search_widenings; ++widened) {
+      const double centre = part.onset_s;
+      for (std::size_t widened = 0;
+           widened < settings.onset_search_widenings + settings.onset_search_doublings; ++widened) {
         const double margin = settings.onset_step_s;
         const bool at_from = first == 0 && sums.front().first > record.t.front() + margin;
         const bool at_to = last + 1 == sums.size() && sums.back().first < record.t.back() - margin;
         if (!at_from && !at_to) break;
-        if (at_from) from -= 2.0 * settings.onset_search_s;
-        if (at_to) to += 2.0 * settings.onset_search_s;
-        sums = summed_errors(from, to, trials);
+        const bool doubling = widened >= settings.onset_search_widenings;
+        if (at_from) from -= doubling ? centre - from : 2.0 * settings.onset_search_s;
+        if (at_to) to += doubling ? to - centre : 2.0 * settings.onset_search_s;
+        // Doubled, the window would reach far beyond the capture, its trials wasted there.
+        sums = doubling ? summed_errors(std::max(from, record.t.front()),
+                                        std::min(to, record.t.back()), trials)
+                        : summed_errors(from, to, trials);
         std::tie(first, last) = flat_stretch(sums);
       }
       part.onset_s = 0.5 * (sums[first].first + sums[last].first);

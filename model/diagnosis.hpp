@@ -142,9 +142,13 @@ struct DiagnosisSettings {
   double onset_search_s = 4.0;
   double onset_step_s = 0.05;
   // While the flat stretch of the summed errors reaches the search window's edge, the window is
-  // widened on that side by 2 x onset_search_s (the number of trials kept), at most this many
-  // times (to 28 s on that side).
+  // widened on that side by 2 x onset_search_s (the number of trials kept), this many times (to
+  // 28 s on that side), then its extent on that side is doubled, up to the capture's ends (at
+  // most `onset_search_doublings` times): an effect that shows only in motion and starts at a
+  // long hold's beginning fits every onset within the hold alike (818215: a droop from 88.6 s,
+  // a hold from 89 to 150 s, reported "between 121.5 and 149.7 s" at 28 s).
   std::size_t onset_search_widenings = 3;
+  std::size_t onset_search_doublings = 4;
   // Trial onsets whose summed error lies within this share of the search's range (largest
   // minus smallest) above the smallest form the flat stretch whose middle is the onset (an
   // effect invisible during a hold; the closed loop's small corrections during it make the

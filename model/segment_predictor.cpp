@@ -464,4 +464,53 @@ double SegmentPredictor::nrmse(const ModelParameters& parameters,
   return nrmse(p, segments);
 }
 
+std::vector<double> segment_errors(const SegmentPredictor& predictor,
+                                   const ModelParameters& parameters,
+                                   std::span<const Segment> segments) {
+  std::vector<double> r(SegmentPredictor::residual_count(segments));
+  predictor.residuals(parameters, segments, r);
+  std::vector<double> out;
+  std::size_t i = 0;
+  for (const auto& seg : segments) {
+    const std::size_t n = 3 * (seg.length - 1);
+    double sum = 0.0;
+    for (std::size_t j = 0; j < n; ++j, ++i) sum += r[i] * r[i];
+    out.push_back(sum / static_cast<double>(n));
+  }
+  return out;
+}
+
+std::vector<double> summed_errors_at_onsets(const SegmentPredictor& predictor,
+                                            const ModelParameters& parameters,
+                                            std::span<const Segment> segments,
+                                            std::span<const double> onsets, double settle_s) {
+  const MeasuredRecord& record = predictor.record();
+  ModelParameters throughout_before = parameters;
+  throughout_before.onset_s = record.t.back() + 1.0;
+  ModelParameters throughout_after = parameters;
+  throughout_after.onset_s = 0.0;
+  const auto errors_before = segment_errors(predictor, throughout_before, segments);
+  const auto errors_after = segment_errors(predictor, throughout_after, segments);
+  ModelParameters trial = parameters;
+  std::vector<double> sums;
+  std::vector<Segment> around;
+  for (const double onset : onsets) {
+    trial.onset_s = onset;
+    double sum = 0.0;
+    around.clear();
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      if (!predictor.reaches(segments[k], onset)) {
+        sum += errors_before[k];
+      } else if (record.t[segments[k].begin] >= onset + settle_s) {
+        sum += errors_after[k];
+      } else {
+        around.push_back(segments[k]);
+      }
+    }
+    for (double e : segment_errors(predictor, trial, around)) sum += e;
+    sums.push_back(sum);
+  }
+  return sums;
+}
+
 }  // namespace leakmon::model

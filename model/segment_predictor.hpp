@@ -146,4 +146,19 @@ class SegmentPredictor {
   mutable RecentResults<SpoolLaw, std::shared_ptr<const std::vector<double>>, 4> spool_runs_;
 };
 
+// Mean squared scaled residual of each segment.
+std::vector<double> segment_errors(const SegmentPredictor& predictor,
+                                   const ModelParameters& parameters,
+                                   std::span<const Segment> segments);
+
+// The error of `parameters` summed over `segments` with its onset moved to each of `onsets`
+// [s] (an onset search). A segment that ends before an onset runs the model before it and one
+// that starts `settle_s` or more after it the model after it (the spool's memory of the switch
+// long gone), whatever the onset: those two runs are simulated once, and only the segments
+// around each onset for it. Equal to simulating every segment for every onset to rounding.
+std::vector<double> summed_errors_at_onsets(const SegmentPredictor& predictor,
+                                            const ModelParameters& parameters,
+                                            std::span<const Segment> segments,
+                                            std::span<const double> onsets, double settle_s = 1.0);
+
 }  // namespace leakmon::model

@@ -443,6 +443,50 @@ TEST(SegmentPredictor, KeptSpoolPositionsGiveTheResidualsOfFreshOnes) {
   }
 }
 
+// The onset search sums the errors over the segments around each trial onset from two runs
+// (the model before the onset throughout and after it throughout) and simulates only the
+// segments near the onset for it: the sums must be those of simulating every segment for every
+// onset, for effects that switch the spool (a bias, a slower spool), a transducer's reading
+// (a lag starting from the pressure it reads) and the flows (a leak).
+TEST(SegmentPredictor, OnsetTrialsSummedAroundEachOnsetEqualWholeSimulations) {
+  const auto seed = test::model_test_seed(
+      "SegmentPredictor.OnsetTrialsSummedAroundEachOnsetEqualWholeSimulations");
+  const SyntheticCase c = draw_case(seed, "valve_bias", {24.0});
+  const MeasuredRecord record = measured_record(simulate_case(c));
+  const SegmentPredictor predictor(record);
+  const auto& all = split_record(record);
+  std::vector<Segment> segments = all.fitting;
+  segments.insert(segments.end(), all.held_out.begin(), all.held_out.end());
+  std::sort(segments.begin(), segments.end(),
+            [](const Segment& a, const Segment& b) { return a.begin < b.begin; });
+  std::vector<ModelParameters> laws(4);
+  laws[0].effects.u0 = 0.05;
+  laws[1].effects.spool_tau = 0.03;
+  laws[2].effects.tau_s = 0.006;
+  laws[3].effects.C_L = 2e-12;
+  std::vector<double> onsets;
+  for (double t = 3.0; t < 21.0; t += 0.37) onsets.push_back(t);
+  for (std::size_t i = 0; i < laws.size(); ++i) {
+    ModelParameters law = laws[i];
+    law.onset_s = 12.0;
+    law.before = ModelParameters{}.effects;
+    const auto sums = summed_errors_at_onsets(predictor, law, segments, onsets);
+    ASSERT_EQ(sums.size(), onsets.size());
+    double lowest = sums.front(), highest = sums.front();
+    for (std::size_t k = 0; k < onsets.size(); ++k) {
+      ModelParameters trial = law;
+      trial.onset_s = onsets[k];
+      double whole = 0.0;
+      for (double e : segment_errors(predictor, trial, segments)) whole += e;
+      EXPECT_NEAR(sums[k], whole, 1e-9 * whole) << "law " << i << ", onset " << onsets[k];
+      lowest = std::min(lowest, sums[k]);
+      highest = std::max(highest, sums[k]);
+    }
+    // The onset matters: otherwise the test would compare constants.
+    EXPECT_GT(highest, 1.001 * lowest) << "law " << i;
+  }
+}
+
 // The whole workflow on a short capture with a clear leak, cheap enough for the sanitizer
 // builds (the full-size random cases are model_diagnosis_test, labelled long).
 TEST(Diagnosis, NamesAClearLeakOnAShortCapture) {

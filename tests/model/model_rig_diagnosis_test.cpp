@@ -328,6 +328,26 @@ TEST(Onset, AnOnsetInsideASineBlockIsFoundBeyondTheProgramsExcitation) {
   EXPECT_NEAR(d.causes.front().onset_s, c.onset_s, 2.0);
 }
 
+// An onset just before a long hold: fixed case 818215 of `model evaluate --programs --rigs other
+// --classes onset --seed 818200` (180 s): a supply droop from 88.60 s on a 48 mm rig whose program
+// runs steps until 89 s, holds until 150 s and then runs a triangle. The onset search widened
+// its window by 8 s at most three times and stopped with the flat stretch still at its edge:
+// "from 135.6 s" (121.5-149.7). The window now doubles on, up to the capture's ends; named with
+// its onset within 2 s (87.53 s, 86.80-88.25) and the stretch reported within 1 s of it.
+TEST(Onset, AnOnsetBeforeALongHoldIsSoughtAcrossTheHold) {
+  const SyntheticCase c = draw_case(818215, "supply_droop", program_onset_on_other_rig());
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_TRUE(d.change_point.has_value());
+  print_splits(c, d);
+  ASSERT_EQ(causes(d), "supply_droop");
+  const auto& cause = d.causes.front();
+  std::printf("  onset %.2f s, between %.2f and %.2f s\n", cause.onset_s, cause.onset_earliest_s,
+              cause.onset_latest_s);
+  EXPECT_NEAR(cause.onset_s, c.onset_s, 2.0);
+  EXPECT_LE(cause.onset_earliest_s, c.onset_s + 1.0);
+  EXPECT_GE(cause.onset_latest_s, c.onset_s - 1.0);
+}
+
 // A constant effect is not said to start where a program's first phase barely shows it: fixed
 // case 818110 of `model evaluate --programs --rigs other --classes library --seed 818100` (180
 // s): a 4 ms lag of p1's transducer from the start on an 86 mm rig whose program opens with 41 s
