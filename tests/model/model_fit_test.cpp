@@ -10,6 +10,7 @@
 
 #include "model/actuator_model.hpp"
 #include "model/calibration_fit.hpp"
+#include "model/change_point.hpp"
 #include "model/diagnosis.hpp"
 #include "model/effect_library.hpp"
 #include "model/force_balance.hpp"
@@ -454,11 +455,7 @@ TEST(SegmentPredictor, OnsetTrialsSummedAroundEachOnsetEqualWholeSimulations) {
   const SyntheticCase c = draw_case(seed, "valve_bias", {24.0});
   const MeasuredRecord record = measured_record(simulate_case(c));
   const SegmentPredictor predictor(record);
-  const auto& all = split_record(record);
-  std::vector<Segment> segments = all.fitting;
-  segments.insert(segments.end(), all.held_out.begin(), all.held_out.end());
-  std::sort(segments.begin(), segments.end(),
-            [](const Segment& a, const Segment& b) { return a.begin < b.begin; });
+  const std::vector<Segment> segments = segments_in_time_order(split_record(record));
   std::vector<ModelParameters> laws(4);
   laws[0].effects.u0 = 0.05;
   laws[1].effects.spool_tau = 0.03;
