@@ -67,7 +67,7 @@ class DetailXcorrDetector final : public Detector {
   bool uses_correlation() const { return correlation_; }
 
   // The layout export_state() writes (legacy_state.hpp reads the ones before).
-  static constexpr int kStateVersion = 6;
+  static constexpr int kStateVersion = 7;
 
  private:
   // Per-hop sums of the details: products of the two chambers' level-2 details, or the energy

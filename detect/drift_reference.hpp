@@ -37,6 +37,16 @@ struct DriftReferenceOptions {
   // A slope needs blocks spanning 0.9 of the window (after a re-anchoring the window refills;
   // over a shorter span the slope's noise, extrapolated over the guard, exceeds the drift).
   bool slope_needs_full_window = false;
+  // When the newest block in the window is older than the guard again (the blocks stopped: a
+  // program the caller does not judge, a stretch under suspicion), the window ends at that
+  // block and the line is carried a guard beyond it, no further: the reference holds what the
+  // blocks said when they stopped. Without, the window slides on and its level is that of
+  // fewer and fewer old blocks (a feature test's reference wandered by 1.5 block spreads
+  // within a minute of a sine that followed the steps, judging the sine by it). With it, the
+  // full window a slope needs is the blocks' own span, not the window's: the window had held
+  // only the 100 s of steps before a three-minute triangle, and their slope was carried 230 s
+  // on to now (a false alarm 38 s into the steps that followed).
+  bool hold_across_gaps = false;
 };
 
 class DriftReference {
@@ -52,6 +62,9 @@ class DriftReference {
   // Forget every block: the residuals before belong to another supply (a re-anchoring), or to
   // another clock (a restart after a gap).
   void clear() { blocks_.clear(); }
+  // A state of a build before hold_across_gaps decides as that build did.
+  void set_hold_across_gaps(bool hold) { options_.hold_across_gaps = hold; }
+  bool holds_across_gaps() const { return options_.hold_across_gaps; }
 
   // The reference at t: 0 with fewer than kLevelBlocks in the window, their level with fewer
   // than kSlopeBlocks or when `level_only`, else the line extrapolated to t. `block_sigma`:

@@ -12,6 +12,9 @@ namespace leakmon::detect {
 
 namespace {
 
+// The ln of a reversal rate, finite at none.
+double log_reversals(double rate) { return std::log(rate + FeatureTest::kReversalFloor); }
+
 // Load activity below this (1e-3 of supply per hop) counts as "still": keeps the log finite.
 constexpr double kActivityFloor = 1e-3;
 // A hop whose load moved less than this (of supply) is at rest for the supply estimate: there
@@ -44,6 +47,7 @@ DriftReferenceOptions drift_options(const FeatureTestOptions& o, const FeaturePh
   d.bound = -physics.design_shift;
   d.shrink_slope = true;
   d.slope_needs_full_window = true;
+  d.hold_across_gaps = true;
   return d;
 }
 
@@ -93,7 +97,8 @@ void FeatureTest::reset() {
   learns_other_regimes_ = true;
   candidate_.clear();
   candidate_rest_run_ = candidate_motion_run_ = 0;
-  block_hop_ = block_valid_ = rest_hops_ = 0;
+  block_hop_ = block_valid_ = rest_hops_ = reversals_ = 0;
+  last_direction_ = 0.0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
   previous_load_ = previous_rough_load_ = last_expected_ = kMissing;
@@ -104,12 +109,14 @@ void FeatureTest::reset() {
   cusum_.reset();
   set_threshold_for_sigma();
   drift_.clear();
+  drift_.set_hold_across_gaps(true);
 }
 
 void FeatureTest::resume_after_gap() {
   drift_.clear();
   supply_.resume_after_gap();
   previous_load_ = previous_rough_load_ = kMissing;
+  last_direction_ = 0.0;
   chamber_supply_.resume_after_gap();
   cusum_.forget_history();
   // The regime's blocks are on the old clock too (their residuals never reach the reference).
@@ -187,9 +194,15 @@ double FeatureTest::expected_feature(const Block& b) const {
 // Adds one hop; true when a block completed with enough valid hops (then `completed` holds it).
 bool FeatureTest::add_to_block(const Observation& o, double temp, double feature, double load,
                                double supply, Block& completed) {
-  const double activity = std::abs(load - previous_load_);
+  const double change = load - previous_load_;
+  const double activity = std::abs(change);
   previous_load_ = load;
   if (!std::isnan(activity)) count_run(activity < kRestActivity);
+  if (activity >= kRestActivity) {
+    const double direction = change > 0.0 ? 1.0 : -1.0;
+    if (last_direction_ != 0.0 && direction != last_direction_) ++reversals_;
+    last_direction_ = direction;
+  }
   const bool settled = supply_.settled(o.t) && !chamber_supply_.awaiting();
   const bool temperature_ok = !temperature_seen_ || !std::isnan(temp);
   if (!std::isnan(feature) && !std::isnan(activity) && settled && temperature_ok) {
@@ -216,14 +229,15 @@ bool FeatureTest::add_to_block(const Observation& o, double temp, double feature
                  std::log(sum_activity_ / n + kActivityFloor),
                  sum_log_friction_ / n,
                  sum_log_supply_ / n,
-                 static_cast<double>(rest_hops_) / n};
+                 static_cast<double>(rest_hops_) / n,
+                 static_cast<double>(reversals_) / options_.block_seconds};
   }
   completed_rest_run_ = block_rest_run_;
   completed_motion_run_ = block_motion_run_;
   // A run that goes on reaches into the next block.
   block_rest_run_ = rest_run_;
   block_motion_run_ = motion_run_;
-  block_hop_ = block_valid_ = rest_hops_ = 0;
+  block_hop_ = block_valid_ = rest_hops_ = reversals_ = 0;
   sum_feature_ = sum_load_ = sum_load_squared_ = sum_activity_ = 0.0;
   sum_log_friction_ = sum_log_supply_ = 0.0;
   return enough;
@@ -313,6 +327,12 @@ FeatureTest::WindowRange FeatureTest::window_mean_range(std::span<const Block> b
     range.low = std::min(range.low, mean);
     range.high = std::max(range.high, mean);
   }
+  return range;
+}
+
+FeatureTest::WindowRange FeatureTest::reversal_range(std::span<const Block> blocks) {
+  const WindowRange range = window_mean_range(blocks, &Block::reversal_rate);
+  if (!(range.low <= range.high)) return {kMissing, kMissing};
   return range;
 }
 
@@ -408,7 +428,7 @@ bool FeatureTest::outside_regime(const Block& block) {
   if (regime_.full() && !std::isnan(regime_.oldest().residual)) {
     drift_.add(regime_.oldest().t, regime_.oldest().residual);
   }
-  regime_.push({block.t, block.rest_share, kMissing, block.log_activity});
+  regime_.push({block.t, block.rest_share, kMissing, block.log_activity, block.reversal_rate});
   bool outside = outside_;  // after a gap: too few blocks to say from the share
   if (regime_.full()) {
     double sum = 0.0;
@@ -441,13 +461,15 @@ void FeatureTest::take_back_ring() {
 // near each other's edges).
 int FeatureTest::other_regime_of_ring() const {
   if (other_count_ == 0 || !regime_.full()) return -1;
-  double share = 0.0, activity = 0.0;
+  double share = 0.0, activity = 0.0, reversals = 0.0;
   for (std::size_t i = 0; i < regime_.size(); ++i) {
     share += regime_.oldest(i).share;
     activity += regime_.oldest(i).activity;
+    reversals += regime_.oldest(i).reversals;
   }
   share /= static_cast<double>(regime_.size());
   activity /= static_cast<double>(regime_.size());
+  reversals /= static_cast<double>(regime_.size());
   if (std::isnan(share) || std::isnan(activity)) return -1;  // a ring from a state before it
   const double rest = static_cast<double>(completed_rest_run_) * hop_seconds();
   const double motion = static_cast<double>(completed_motion_run_) * hop_seconds();
@@ -456,8 +478,13 @@ int FeatureTest::other_regime_of_ring() const {
     const double widen = static_cast<int>(k) == judging_other_ ? 1.0 : 0.5;
     const double share_margin = widen * options_.regime_tolerance;
     const double activity_margin = widen * kActivityTolerance;
-    return share >= r.rest_low - share_margin && share <= r.rest_high + share_margin &&
-           activity >= r.activity_low - activity_margin &&
+    // A regime learned without the rate, or a ring from a state before it: as then.
+    const bool frequency_fits =
+        std::isnan(r.reversals_low) || std::isnan(reversals) ||
+        (log_reversals(reversals) >= log_reversals(r.reversals_low) - widen * kFrequencyTolerance &&
+         log_reversals(reversals) <= log_reversals(r.reversals_high) + widen * kFrequencyTolerance);
+    return frequency_fits && share >= r.rest_low - share_margin &&
+           share <= r.rest_high + share_margin && activity >= r.activity_low - activity_margin &&
            activity <= r.activity_high + activity_margin &&
            rest <= kRunFactor * r.longest_rest + kMotionRunSlackSeconds &&
            motion <= kRunFactor * r.longest_motion + kMotionRunSlackSeconds;
@@ -490,8 +517,10 @@ void FeatureTest::learn_other(const Block& block) {
   if (candidate_.size() >= kRegimeBlocks) {
     const WindowRange share = window_mean_range(candidate_, &Block::rest_share);
     const WindowRange activity = window_mean_range(candidate_, &Block::log_activity);
+    const WindowRange reversals = reversal_range(candidate_);  // NaN: compared as then
     if (share.high - share.low > 2.0 * options_.regime_tolerance ||
-        activity.high - activity.low > 2.0 * kActivityTolerance) {
+        activity.high - activity.low > 2.0 * kActivityTolerance ||
+        log_reversals(reversals.high) - log_reversals(reversals.low) > 2.0 * kFrequencyTolerance) {
       const auto keep = static_cast<std::ptrdiff_t>(kRegimeBlocks / 2);
       candidate_.erase(candidate_.begin(), candidate_.end() - keep);
       candidate_rest_run_ = completed_rest_run_;
@@ -524,7 +553,7 @@ bool FeatureTest::judge_without_steps(bool completed, const Block& block, Verdic
     return false;
   }
   if (completed && !chamber_supply_.awaiting()) {
-    regime_.push({block.t, block.rest_share, kMissing, block.log_activity});
+    regime_.push({block.t, block.rest_share, kMissing, block.log_activity, block.reversal_rate});
     bool moving = false;
     if (regime_.full()) {
       double share = 0.0;
@@ -615,6 +644,9 @@ void FeatureTest::finish_other() {
   r.activity_high = activity.high;
   r.longest_rest = static_cast<double>(candidate_rest_run_) * hop_seconds();
   r.longest_motion = static_cast<double>(candidate_motion_run_) * hop_seconds();
+  const WindowRange reversals = reversal_range(candidate_);
+  r.reversals_low = reversals.low;
+  r.reversals_high = reversals.high;
   others_[other_count_++] = r;
   candidate_.clear();
   candidate_rest_run_ = candidate_motion_run_ = 0;
@@ -774,6 +806,8 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
     state.put(key("threshold.siegmund"), siegmund_threshold_ ? 1.0 : 0.0);
   }
   state.put_count(key("block.rest_hops"), rest_hops_);
+  state.put_count(key("block.reversals"), reversals_);
+  state.put(key("run.direction"), last_direction_);
   state.put_count(key("block.hops"), block_hop_);
   state.put_count(key("block.valid"), block_valid_);
   state.put(key("block.sum_feature"), sum_feature_);
@@ -789,6 +823,7 @@ void FeatureTest::save(DetectorState& state, std::string_view prefix) const {
   supply_.save(state, key("supply"));
   chamber_supply_.save(state, key("chamber_supply"));
   state.put(key("learned_supply"), learned_supply_);
+  state.put(key("drift_holds_across_gaps"), drift_.holds_across_gaps() ? 1.0 : 0.0);
   cusum_.save(state, key("cusum"));
   drift_.save(state, key("drift"));
 }
@@ -846,9 +881,15 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
   candidate_rest_run_ = state.get_count(key("others.candidate_rest_run"));
   candidate_motion_run_ = state.get_count(key("others.candidate_motion_run"));
   rest_hops_ = state.get_count(key("block.rest_hops"));
+  reversals_ = state.get_count(key("block.reversals"));
+  last_direction_ = state.get(key("run.direction"));
+  if (last_direction_ != 0.0 && last_direction_ != 1.0 && last_direction_ != -1.0) {
+    throw StateError("the load's last direction is neither -1, 0 nor 1");
+  }
   block_hop_ = state.get_count(key("block.hops"));
   block_valid_ = state.get_count(key("block.valid"));
-  if (block_hop_ >= block_hops_ || block_valid_ > block_hop_ || rest_hops_ > block_valid_) {
+  if (block_hop_ >= block_hops_ || block_valid_ > block_hop_ || rest_hops_ > block_valid_ ||
+      reversals_ > block_hop_) {
     throw StateError("block position out of range");
   }
   sum_feature_ = state.get(key("block.sum_feature"));
@@ -864,6 +905,7 @@ void FeatureTest::restore(const DetectorState& state, std::string_view prefix) {
   supply_.restore(state, key("supply"));
   chamber_supply_.restore(state, key("chamber_supply"));
   learned_supply_ = state.get(key("learned_supply"));
+  drift_.set_hold_across_gaps(state.get(key("drift_holds_across_gaps")) != 0.0);
   cusum_.restore(state, key("cusum"));
   drift_.restore(state, key("drift"));
 }

@@ -58,6 +58,12 @@
 //   starts over. A program neither learned nor learnable stays `outside_learned_regime`.
 //   Such a program is learned and judged before the steps are learned too (a shift that
 //   begins with a durability block), while the steps' learning waits beside it.
+// - Rest share and activity do not see frequency: a sweep passing a learned sine's activity
+//   (about amplitude x frequency) was told as that sine and judged by its baseline at twice its
+//   frequency. So a program is also told by its reversal rate, the load's changes of direction
+//   per second over kRegimeBlocks blocks (a sine's is twice its frequency); a learned program
+//   stays told only while the rate lies within kFrequencyTolerance (in ln) of its learned range,
+//   and a learning period whose rate moves by more than twice that began in another program.
 // The detectors on top (index_cusum, detail_xcorr) say what the feature is and how it moves:
 // that is all they add.
 #pragma once
@@ -159,6 +165,11 @@ class FeatureTest {
   // frequency moves the load's activity by its ratio).
   static constexpr std::size_t kMaxOtherRegimes = 3;
   static constexpr double kActivityTolerance = 0.4;
+  // How far (in ln) a program's reversal rate over kRegimeBlocks blocks may lie outside its
+  // learned range and still be that program (a sine within about 20 % of its frequency), and the
+  // rate below which reversals are compared as this (a 0.1 Hz sine: the ln stays finite).
+  static constexpr double kFrequencyTolerance = 0.2;
+  static constexpr double kReversalFloor = 0.2;
   // The other regime whose baseline judges the current blocks (-1: none), and how many are
   // learned: for the tests and the status.
   int judging_regime() const { return judging_other_; }
@@ -186,8 +197,9 @@ class FeatureTest {
   // One block's means: the response and its regressors.
   struct Block {
     double t, feature, load, load_squared, log_activity, log_friction, log_supply, rest_share;
+    double reversal_rate;  // the load's changes of direction per second (NaN: a state before)
   };
-  static constexpr std::array<RecordField<Block>, 8> kBlockFields = {
+  static constexpr std::array<RecordField<Block>, 9> kBlockFields = {
       record_field<&Block::t>("t"),
       record_field<&Block::feature>("feature"),
       record_field<&Block::load>("load"),
@@ -195,31 +207,38 @@ class FeatureTest {
       record_field<&Block::log_activity>("log_activity"),
       record_field<&Block::log_friction>("log_friction"),
       record_field<&Block::log_supply>("log_supply"),
-      record_field<&Block::rest_share>("rest_share")};
+      record_field<&Block::rest_share>("rest_share"),
+      record_field<&Block::reversal_rate>("reversal_rate")};
   struct WindowRange {
     double low, high;
   };
   static WindowRange window_mean_range(std::span<const Block> blocks, double Block::*field);
+  // The range of the blocks' reversal rate; NaN where no window has one (blocks of a state
+  // from before it).
+  static WindowRange reversal_range(std::span<const Block> blocks);
   // A block of the regime test: its share of hops at rest, and its feature residual
   // waiting to enter the drift reference (NaN: it does not) until kRegimeBlocks later blocks
   // showed no excursion.
   struct RegimeEntry {
-    double t, share, residual, activity;
+    double t, share, residual, activity, reversals;
   };
-  static constexpr std::array<RecordField<RegimeEntry>, 4> kRegimeFields = {
+  static constexpr std::array<RecordField<RegimeEntry>, 5> kRegimeFields = {
       record_field<&RegimeEntry::t>("t"), record_field<&RegimeEntry::share>("share"),
       record_field<&RegimeEntry::residual>("residual"),
-      record_field<&RegimeEntry::activity>("activity")};
+      record_field<&RegimeEntry::activity>("activity"),
+      record_field<&RegimeEntry::reversals>("reversals")};
   // A program learned besides the first: the feature's model in it (constant, load, load^2,
   // log activity; the temperature term is the first program's), its block spread, the drift
   // reference when it was learned (its baseline moves with the reference since), and what tells
   // it: the range of its rest share and mean log activity over kRegimeBlocks blocks, and its
-  // longest rest and motion runs [s].
+  // longest rest and motion runs [s], and the range of its reversal rate [1/s] (NaN: learned by
+  // a build that did not read it).
   struct OtherRegime {
     double constant, load, load_squared, log_activity, sigma, reference;
     double rest_low, rest_high, activity_low, activity_high, longest_rest, longest_motion;
+    double reversals_low, reversals_high;
   };
-  static constexpr std::array<RecordField<OtherRegime>, 12> kOtherRegimeFields = {
+  static constexpr std::array<RecordField<OtherRegime>, 14> kOtherRegimeFields = {
       record_field<&OtherRegime::constant>("constant"),
       record_field<&OtherRegime::load>("load"),
       record_field<&OtherRegime::load_squared>("load_squared"),
@@ -231,7 +250,9 @@ class FeatureTest {
       record_field<&OtherRegime::activity_low>("activity_low"),
       record_field<&OtherRegime::activity_high>("activity_high"),
       record_field<&OtherRegime::longest_rest>("longest_rest"),
-      record_field<&OtherRegime::longest_motion>("longest_motion")};
+      record_field<&OtherRegime::longest_motion>("longest_motion"),
+      record_field<&OtherRegime::reversals_low>("reversals_low"),
+      record_field<&OtherRegime::reversals_high>("reversals_high")};
   static constexpr int kRegressors = 5;
   double load_of(const Observation& o, double supply) const;
   double expected_feature(const Block& block) const;
@@ -303,6 +324,9 @@ class FeatureTest {
   double sum_feature_ = 0.0, sum_load_ = 0.0, sum_load_squared_ = 0.0, sum_activity_ = 0.0;
   double sum_log_friction_ = 0.0, sum_log_supply_ = 0.0;
   std::size_t rest_hops_ = 0;  // the block's valid hops at rest
+  // The direction of the load's last move (+1, -1; 0 none yet), and the block's reversals of it.
+  double last_direction_ = 0.0;
+  std::size_t reversals_ = 0;
   double previous_load_ = kMissing;
   double previous_rough_load_ = kMissing;  // normalised by the configured supply
   double last_expected_ = kMissing;

@@ -57,7 +57,7 @@ class IndexCusumDetector final : public Detector {
   void resume_after_gap() override { test_.resume_after_gap(); }
 
   // The layout export_state() writes (legacy_state.hpp reads the ones before).
-  static constexpr int kStateVersion = 7;
+  static constexpr int kStateVersion = 8;
 
  private:
   double log_index_of(const Observation& observation) const;

@@ -414,10 +414,39 @@ DetectorState feature_test_from_one_regime(const DetectorState& old, int version
   return c.out();
 }
 
+// The feature test before it read the load's reversal rate (index_cusum 7, detail_xcorr 6, and
+// the layouts before once converted to them): its blocks and learned programs have none, so a
+// program it learned is told as that build told it (rest share, activity and runs), and its
+// drift reference slides on across a gap in its blocks as that build's did.
+DetectorState feature_test_from_no_reversals(const DetectorState& old, int version,
+                                             std::string_view prefix) {
+  Conversion c(old, version);
+  for (const auto& [key, values] : old.entries()) c.put(key, values);
+  const auto key = [prefix](std::string_view name) { return state_key(prefix, name); };
+  const auto none_for = [&](std::string_view list, std::string_view like) {
+    c.put(key(list), std::vector<double>(c.list(key(like)).size(), kNaN));
+  };
+  none_for("learned.reversal_rate", "learned.t");
+  none_for("others.candidate.reversal_rate", "others.candidate.t");
+  none_for("regime.blocks.reversals", "regime.blocks.t");
+  none_for("others.reversals_low", "others.constant");
+  none_for("others.reversals_high", "others.constant");
+  c.out().put_count(key("block.reversals"), 0);
+  c.put(key("run.direction"), 0.0);
+  c.put(key("drift_holds_across_gaps"), 0.0);
+  return c.out();
+}
+
 }  // namespace
 
 DetectorState upgraded_state(const DetectorState& state, std::string_view kind, int version) {
   if (state.kind() == kind && state.version() == version) return state;
+  if (state.kind() == kind && kind == "index_cusum" && version == 8 && state.version() < 8) {
+    return feature_test_from_no_reversals(upgraded_state(state, kind, 7), 8, "");
+  }
+  if (state.kind() == kind && kind == "detail_xcorr" && version == 7 && state.version() < 7) {
+    return feature_test_from_no_reversals(upgraded_state(state, kind, 6), 7, "test");
+  }
   if (state.kind() == kind && kind == "index_cusum" && version == 7 && state.version() < 7) {
     return feature_test_from_one_regime(upgraded_state(state, kind, 6), 7, "");
   }

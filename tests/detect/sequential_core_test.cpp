@@ -203,6 +203,33 @@ TEST(DriftReference, ANoisySlopeIsShrunkAClearOneFollowed) {
   EXPECT_NEAR(short_span.reference(100.0, 1e-6, false, kNaN), -0.02, 1e-12) << "level";
 }
 
+// Blocks that stop early in the window (the first program left for another one the feature
+// test does not judge) span less than it however early the first of them lies: their level, not
+// their slope carried across the gap to now, and held there however long the gap lasts. A
+// reference without hold_across_gaps (a state of a build before it) slides on as it did.
+TEST(DriftReference, BlocksThatStopGiveTheirLevelAndHoldIt) {
+  DriftReferenceOptions options = drift_options(1.0, true);
+  options.hold_across_gaps = true;
+  DriftReference drift(options);
+  DriftReference before(drift_options(1.0, true));
+  // The window at 100 is [50, 90]; the blocks span 50-62, then nothing.
+  const auto residual = [](double t) { return 1e-3 * (t - 56.0); };
+  for (double t = 50.0; t <= 62.0; t += 0.5) {
+    drift.add(t, residual(t));
+    before.add(t, residual(t));
+  }
+  EXPECT_NEAR(drift.reference(100.0, 1e-6, false, kNaN), 0.0, 1e-12) << "their level";
+  EXPECT_NEAR(before.reference(100.0, 1e-6, false, kNaN), 0.044, 1e-9) << "the slope carried";
+  EXPECT_NEAR(drift.reference(1000.0, 1e-6, false, kNaN), 0.0, 1e-12) << "held";
+  EXPECT_EQ(before.reference(1000.0, 1e-6, false, kNaN), 0.0) << "slid past them";
+  // While they age out of the sliding window, its level is that of the last few.
+  EXPECT_NEAR(before.reference(110.0, 1e-6, false, kNaN), residual(61.0), 1e-12);
+  EXPECT_NEAR(drift.reference(110.0, 1e-6, false, kNaN), 0.0, 1e-12);
+  // Blocks again at the window's end: the line through both is followed.
+  for (double t = 86.0; t <= 90.0; t += 0.5) drift.add(t, residual(t));
+  EXPECT_NEAR(drift.reference(100.0, 1e-6, false, kNaN), 0.044, 1e-9) << "the line";
+}
+
 // After a re-anchoring the blocks since the step are all the reference there is: the window
 // reaches up to the end of the anchoring, inside the guard; with following off, only they count.
 TEST(DriftReference, AfterAReAnchoringItsBlocksAreTheReference) {
