@@ -19,7 +19,8 @@
 //   blocks judged since the step began are taken back out of the CUSUM, and the test does not
 //   judge until the holds after the step give the new supply, then re-anchors as above.
 // - What is left of slow drift is followed (DriftReference): blocks are judged against a trend
-//   of the residuals in a window that ends `drift_guard_seconds` ago.
+//   of the residuals in a window that ends `drift_guard_seconds` ago, or at the last block when
+//   the blocks stopped (another program, a suspicious stretch): held, not slid past them.
 // Test programs (MODEL.md "Test programs", issue 23) change the excitation by orders of
 // magnitude, and with it every feature the pressures give:
 // - Learning waits for a program that moves and rests (steps, which ring the mode): a learning
