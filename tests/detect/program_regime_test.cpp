@@ -354,21 +354,32 @@ TEST(PressureOnlyPrograms, ALearnedSineIsToldAgainWhenItReturns) {
   EXPECT_LT(again.first_raise, rig.onset + 60.0);
 }
 
+// A sine of `amplitude` [m] at `hz`, ringing the mode at `share`, until 400 s: the hops judged
+// after 345 s (its first 15 s are the regime ring's) and the highest score.
+struct OtherSine {
+  std::size_t judged = 0;
+  double max_score = 0.0;
+};
+OtherSine other_sine_until_400(Detector& detector, test::SyntheticRig& rig, double amplitude,
+                               double hz, double share) {
+  OtherSine r;
+  while (rig.t < 400.0) {
+    const Decision d = detector.update(sine(rig, amplitude, hz, share));
+    if (rig.t > 345.0 && d.judged) ++r.judged;
+    if (!std::isnan(d.score)) r.max_score = std::max(r.max_score, d.score);
+  }
+  return r;
+}
+
 // Another sine (twice the amplitude, ringing the mode less) is not the learned one: it is not
 // judged by that baseline (it would read as a leak) until it has been learned itself.
 TEST(PressureOnlyPrograms, AnotherSineIsNotJudgedByTheLearnedOne) {
   auto detector = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
   test::SyntheticRig rig;
   steps_then_sine(*detector, rig, 200.0, 330.0);
-  double max_score = 0.0;
-  std::size_t judged = 0;
-  while (rig.t < 400.0) {
-    const Decision d = detector->update(sine(rig, 0.04, 0.5, 0.4));
-    if (rig.t > 345.0 && d.judged) ++judged;
-    if (!std::isnan(d.score)) max_score = std::max(max_score, d.score);
-  }
-  EXPECT_EQ(judged, 0U);
-  EXPECT_LT(max_score, 1.0);
+  const OtherSine r = other_sine_until_400(*detector, rig, 0.04, 0.5, 0.4);
+  EXPECT_EQ(r.judged, 0U);
+  EXPECT_LT(r.max_score, 1.0);
 }
 
 // A sine of another frequency at the same load activity (amplitude x frequency) and rest share:
@@ -380,15 +391,9 @@ TEST(PressureOnlyPrograms, AnotherFrequencyAtTheLearnedActivityIsNotJudgedByTheL
   test::SyntheticRig rig;
   const SineRun learned = steps_then_sine(*detector, rig, 200.0, 330.0);
   ASSERT_TRUE(learned.last.judged);  // the 0.5 Hz sine, learned and judged
-  double max_score = 0.0;
-  std::size_t judged = 0;
-  while (rig.t < 400.0) {
-    const Decision d = detector->update(sine(rig, 0.0125, 0.8, 0.45));
-    if (rig.t > 345.0 && d.judged) ++judged;
-    if (!std::isnan(d.score)) max_score = std::max(max_score, d.score);
-  }
-  EXPECT_EQ(judged, 0U);
-  EXPECT_LT(max_score, 1.0);
+  const OtherSine r = other_sine_until_400(*detector, rig, 0.0125, 0.8, 0.45);
+  EXPECT_EQ(r.judged, 0U);
+  EXPECT_LT(r.max_score, 1.0);
   // Back at the learned frequency, the sine is told again.
   std::size_t judged_again = 0;
   while (rig.t < 430.0) {
@@ -470,8 +475,8 @@ TEST(PressureOnlyPrograms, StatesSavedWhileLearningAndJudgingASineRoundTrip) {
   }
 }
 
-// A state of the layout (index_cusum 6: one regime) loads as layout 8 and learns no
-// other program, as that build did: the sine stays outside the learned regime.
+// A state of the layout before other programs (index_cusum 6: one regime) loads as layout 8 and
+// learns no other program, as that build did: the sine stays outside the learned regime.
 TEST(PressureOnlyPrograms, AStateFromBeforeLearnsNoOtherProgram) {
   auto original = make_detector("index_cusum", kPressuresOnly, 0.04, nullptr);
   test::SyntheticRig rig;
