@@ -163,9 +163,11 @@ class FeatureTest {
   // Per-regime learning (the file comment): how many programs besides the first one are
   // learned, and how far (in ln) a program's mean log load activity over kRegimeBlocks blocks
   // may lie outside its learned range and still be that program (a sine at another amplitude or
-  // frequency moves the load's activity by its ratio).
+  // frequency moves the load's activity by its ratio). 0.2: a 2.85 Hz, 40 mm sine lay 0.23 from
+  // a learned 2.74 Hz, 32 mm one and 4 % from its rate, was judged by its baseline at 0.4 and
+  // raised a false leak (docs/detection.md, 2026-11-30, seed 5150 run 24).
   static constexpr std::size_t kMaxOtherRegimes = 3;
-  static constexpr double kActivityTolerance = 0.4;
+  static constexpr double kActivityTolerance = 0.2;
   // How far (in ln) a program's reversal rate over kRegimeBlocks blocks may lie outside its
   // learned range and still be that program (a sine within about 20 % of its frequency), and the
   // rate below which reversals are compared as this (a 0.1 Hz sine: the ln stays finite).
