@@ -243,8 +243,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // Screening: each candidate fitted together with the calibration on a few segments, from the
   // catalogue calibration (not from the nominal fit: a large effect distorts the nominal fit,
   // which then leads the solver into a compensating local minimum).
-  const auto screening_segments =
-      spread_with_excitation(d.fitting_used, settings.screening_segments, record);
+  const auto screening_segments = spread(d.fitting_used, settings.screening_segments);
   FitSettings screening = fit_settings;
   screening.max_iterations = settings.screening_iterations;
   std::vector<FitResult> screened;
@@ -825,11 +824,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       // from 109.0 s split at 118.5 s, the summed error still falling at the window's edge):
       // while the flat stretch reaches the window's edge, the window is widened on that side.
       // A widened window keeps the number of trials (its step grows with it, to 0.2 s at
-      // +-16 s): a flat stretch is known to within its length anyway. The stretch need not
-      // reach the edge's very trial: a sum falling steeply towards the edge can tick up at its
-      // last trial by the noise (818221: a dead band from 124.9 s, sought from 144 s, stopped
-      // at 140.05 s, one trial inside the window, the sum still falling 30 % per 0.2 s), so a
-      // stretch within a twentieth of the window of an edge widens it too.
+      // +-16 s): a flat stretch is known to within its length anyway.
       const int trials =
           2 * static_cast<int>(std::lround(settings.onset_search_s / settings.onset_step_s)) + 1;
       double from = part.onset_s - settings.onset_search_s;
@@ -841,10 +836,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       for (std::size_t widened = 0;
            widened < settings.onset_search_widenings + settings.onset_search_doublings; ++widened) {
         const double margin = settings.onset_step_s;
-        const std::size_t edge = std::max<std::size_t>(1, sums.size() / 20);
-        const bool at_from = first < edge && sums.front().first > record.t.front() + margin;
-        const bool at_to =
-            last + edge >= sums.size() && sums.back().first < record.t.back() - margin;
+        const bool at_from = first == 0 && sums.front().first > record.t.front() + margin;
+        const bool at_to = last + 1 == sums.size() && sums.back().first < record.t.back() - margin;
         if (!at_from && !at_to) break;
         const bool doubling = widened >= settings.onset_search_widenings;
         if (at_from) from -= doubling ? centre - from : 2.0 * settings.onset_search_s;

@@ -62,38 +62,6 @@ std::vector<Segment> spread(std::span<const Segment> segments, std::size_t count
   return out;
 }
 
-std::vector<Segment> spread_with_excitation(std::span<const Segment> segments, std::size_t count,
-                                            const MeasuredRecord& record) {
-  std::vector<Segment> out = spread(segments, count);
-  if (out.size() == segments.size() || count < 4) return out;
-  const auto command_range = [&](const Segment& s) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::size_t i = s.begin; i < s.begin + s.length; ++i) {
-      if (!record.valid[i]) continue;
-      lo = std::min(lo, record.u[i]);
-      hi = std::max(hi, record.u[i]);
-    }
-    return hi > lo ? hi - lo : 0.0;
-  };
-  const auto by_range = [&](const Segment& a, const Segment& b) {
-    return command_range(a) > command_range(b);
-  };
-  std::vector<Segment> excited(segments.begin(), segments.end());
-  std::stable_sort(excited.begin(), excited.end(), by_range);
-  const double largest = command_range(excited.front());
-  const bool sees_largest = std::any_of(
-      out.begin(), out.end(), [&](const Segment& s) { return command_range(s) >= 0.5 * largest; });
-  if (largest <= 0.0 || sees_largest) return out;
-  // The least excited chosen segments go; the most excited ones (none of them chosen, as none
-  // reaches half the largest range) come in, and the set stays in time order.
-  std::stable_sort(out.begin(), out.end(), by_range);
-  const std::size_t swapped = count / 4;
-  for (std::size_t i = 0; i < swapped; ++i) out[out.size() - 1 - i] = excited[i];
-  std::sort(out.begin(), out.end(),
-            [](const Segment& a, const Segment& b) { return a.begin < b.begin; });
-  return out;
-}
-
 SegmentPredictor::SegmentPredictor(const MeasuredRecord& record, const sim::Parameters& rig)
     : record_(record), rig_(rig) {
   scales_ = {std_dev(record.x, record.valid), std_dev(record.p1, record.valid),

@@ -41,12 +41,6 @@ struct SplitSettings {
 SegmentPlan split_record(const MeasuredRecord& record, const SplitSettings& settings = {});
 // At most `count` segments, spread evenly over `segments` (to bound the cost of fitting).
 std::vector<Segment> spread(std::span<const Segment> segments, std::size_t count);
-// `spread`, unless it misses the capture's largest commands (none of its segments has half the
-// largest command range of `segments`): then its least excited segments give way to the most
-// excited ones, a quarter of `count`. Effects that show only in transients (a slow spool, a dead
-// band) are seen only there; an even spread of a capture that mostly holds can miss every step.
-std::vector<Segment> spread_with_excitation(std::span<const Segment> segments, std::size_t count,
-                                            const MeasuredRecord& record);
 
 // Predicted readings, record-sized; NaN outside the simulated segments.
 struct Prediction {

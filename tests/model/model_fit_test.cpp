@@ -418,54 +418,6 @@ TEST(Calibration, SkippingSegmentsBeforeAnOnsetGivesTheFitOfSimulatingThemAll) {
 // The predictor keeps the spool positions of its last few spool laws: residuals from a kept
 // run must be those of a predictor that has kept nothing, also after the laws kept have been
 // replaced (more laws than it keeps, in turn, twice) and with a law switching at an onset.
-// Screening fits every candidate on a few segments. A capture that mostly holds, spread evenly,
-// can give segments that all hold (CI's seed 9203942424485235604: 11 of 12 at rest, a slow
-// spool named a transducer lag): the largest commands then take the place of the quietest.
-TEST(SegmentPredictor, AnEvenSpreadThatMissesEveryStepTakesTheLargestCommands) {
-  MeasuredRecord record;
-  const std::size_t n = 48 * 250;
-  record.t.resize(n);
-  record.u.assign(n, 0.0);
-  record.valid.assign(n, true);
-  for (std::size_t i = 0; i < n; ++i) {
-    record.t[i] = 0.002 * static_cast<double>(i);
-    record.u[i] = 0.01 * std::sin(0.7 * static_cast<double>(i));  // a hold's controller noise
-  }
-  std::vector<Segment> segments;
-  for (std::size_t k = 0; k < 48; ++k) segments.push_back({k * 250, 250});
-  // Steps in segments 6, 17, 30 and 33; spread(12) takes every fourth, 0, 4, ..., 44.
-  const auto step_in = [&](std::size_t k, double size) {
-    for (std::size_t i = k * 250 + 100; i < (k + 1) * 250; ++i) record.u[i] += size;
-  };
-  step_in(6, 9.0);
-  step_in(17, 2.0);
-  step_in(30, 10.0);
-  step_in(33, 8.0);
-  const auto even = spread(segments, 12);
-  const auto chosen = spread_with_excitation(segments, 12, record);
-  ASSERT_EQ(chosen.size(), 12u);
-  const auto has = [&](const std::vector<Segment>& set, std::size_t k) {
-    return std::any_of(set.begin(), set.end(),
-                       [&](const Segment& s) { return s.begin == k * 250; });
-  };
-  for (std::size_t k : {6u, 17u, 30u, 33u}) EXPECT_FALSE(has(even, k)) << "segment " << k;
-  // A quarter of twelve: the three largest commands, in time order with the rest of the spread.
-  EXPECT_TRUE(has(chosen, 6));
-  EXPECT_TRUE(has(chosen, 30));
-  EXPECT_TRUE(has(chosen, 33));
-  EXPECT_FALSE(has(chosen, 17));
-  EXPECT_TRUE(std::is_sorted(chosen.begin(), chosen.end(),
-                             [](const Segment& a, const Segment& b) { return a.begin < b.begin; }));
-  int kept = 0;
-  for (const auto& s : even) kept += has(chosen, s.begin / 250);
-  EXPECT_EQ(kept, 9) << "the three quietest segments of the spread give way, no others";
-  // A spread that already holds half the largest command is left as it is.
-  step_in(8, 6.0);
-  const auto seen = spread_with_excitation(segments, 12, record);
-  ASSERT_EQ(seen.size(), even.size());
-  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].begin, even[i].begin);
-}
-
 TEST(SegmentPredictor, KeptSpoolPositionsGiveTheResidualsOfFreshOnes) {
   const auto seed =
       test::model_test_seed("SegmentPredictor.KeptSpoolPositionsGiveTheResidualsOfFreshOnes");
