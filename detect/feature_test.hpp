@@ -165,7 +165,8 @@ class FeatureTest {
   // may lie outside its learned range and still be that program (a sine at another amplitude or
   // frequency moves the load's activity by its ratio). 0.2: a 2.85 Hz, 40 mm sine lay 0.23 from
   // a learned 2.74 Hz, 32 mm one and 4 % from its rate, was judged by its baseline at 0.4 and
-  // raised a false leak (docs/detection.md, 2026-11-30, seed 5150 run 24).
+  // raised a false leak (docs/detection.md, 2026-11-30, seed 5150 run 24). The same tolerance
+  // bounds a learning period: one whose mean activity spans more than twice it starts over.
   static constexpr std::size_t kMaxOtherRegimes = 3;
   static constexpr double kActivityTolerance = 0.2;
   // How far (in ln) a program's reversal rate over kRegimeBlocks blocks may lie outside its
