@@ -108,6 +108,10 @@ struct DiagnosisSettings {
   std::size_t step_candidates = 4;
   double min_step_score = 0.005;
   double min_step_significance = 2.5;
+  // Forward selection is greedy: with two or more causes named, an effect whose refined score
+  // alone came within this of the first cause's is tried in its place with the others, and
+  // kept where that model predicts the held-out data better (docs/model-check.md).
+  double swap_score_margin = 0.02;
   // Drift: a parameter fitted on the first and on the last third of the fitting segments that
   // differs by more than `drift_z` standard errors (optimistic ones, docs/model-check.md) and
   // by more than the relative amount (calibration, the first cause's main parameter).
@@ -170,6 +174,9 @@ struct SelectionStep {
   double score = 0.0;         // share of the previous model's held-out error it removes
   double significance = 0.0;  // paired / trimmed t of the per-segment log gain
   bool accepted = false;
+  // Not empty: a swap, not an addition. `effect` took the place of this named cause (score and
+  // significance then against the model before the swap).
+  std::string replaces;
 };
 
 struct NamedCause {

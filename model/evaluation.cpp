@@ -112,8 +112,9 @@ CaseOutcome evaluate_case(std::uint64_t seed, const std::string& effect,
   for (const auto& cause : d.causes) out.causes += (out.causes.empty() ? "" : "+") + cause.effect;
   out.drifts = d.drifts || (d.unexplained && d.unexplained->drifts);
   for (const auto& s : d.steps) {
-    out.steps += fmt::format("{}{}:{:.3f}/{:.1f}{}", out.steps.empty() ? "" : ";", s.effect,
-                             s.score, s.significance, s.accepted ? "" : "(rejected)");
+    out.steps += fmt::format("{}{}{}:{:.3f}/{:.1f}{}", out.steps.empty() ? "" : ";", s.effect,
+                             s.replaces.empty() ? "" : "<-" + s.replaces, s.score, s.significance,
+                             s.accepted ? "" : "(rejected)");
   }
   for (const auto& name : d.at_bound) out.at_bound += (out.at_bound.empty() ? "" : "+") + name;
   return out;

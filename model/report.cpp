@@ -187,8 +187,11 @@ std::string markdown(const MeasuredRecord& r, const Diagnosis& d, bool plots) {
         "|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < d.steps.size(); ++i) {
       const auto& st = d.steps[i];
-      out += fmt::format("| {} | {} | {:.4f} | {:.4f} | {:.2f} | {} |\n", i + 1, st.effect,
-                         st.nrmse, st.score, st.significance, st.accepted ? "yes" : "no");
+      const std::string effect = st.replaces.empty()
+                                     ? st.effect
+                                     : fmt::format("{} in place of {}", st.effect, st.replaces);
+      out += fmt::format("| {} | {} | {:.4f} | {:.4f} | {:.2f} | {} |\n", i + 1, effect, st.nrmse,
+                         st.score, st.significance, st.accepted ? "yes" : "no");
     }
     out += "\n";
   }

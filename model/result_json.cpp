@@ -155,9 +155,10 @@ std::string diagnosis_json(const Diagnosis& d) {
     const auto& s = d.steps[i];
     out += fmt::format(
         "{}{{\"effect\": \"{}\", \"nrmse\": {}, \"score\": {}, \"significance\": {}, "
-        "\"accepted\": {}}}",
+        "\"accepted\": {}{}}}",
         i ? ", " : "", s.effect, number(s.nrmse), number(s.score), number(s.significance),
-        s.accepted ? "true" : "false");
+        s.accepted ? "true" : "false",
+        s.replaces.empty() ? std::string() : fmt::format(", \"replaces\": \"{}\"", s.replaces));
   }
   out += "],\n";
   out += fmt::format("  \"nrmse_floor\": {},\n", number(d.nrmse_floor));
