@@ -20,7 +20,6 @@
 #include "model/calibration_fit.hpp"
 #include "model/change_point.hpp"
 #include "model/diagnosis.hpp"
-#include "model/evaluation.hpp"
 #include "model/effect_library.hpp"
 #include "model/rig_check.hpp"
 #include "model/rig_source.hpp"
@@ -210,7 +209,7 @@ TEST(ProgramCases, AProgramReplacesTheStepsOnTheSameRigWithTheSameEffects) {
     }
     EXPECT_NEAR(total, 60.0, 1e-9);
     // A program is drawn again while the rig cannot run it; a rig that was drawn on 12 s of
-    // steps may still ring over the whole capture (1-2 % of draws), and then no program helps.
+    // steps may still ring over the whole capture (3 of 600 draws), and then no program helps.
     const sim::Viability steps_run = sim::check_viability(a.scenario, 60.0);
     const sim::Viability runs = sim::check_viability(b.scenario, 60.0);
     EXPECT_TRUE(runs.ok || !steps_run.ok) << "seed " << first + i << ": " << runs.reason;
@@ -435,4 +434,3 @@ TEST(ModelCheckCli, RigOptionsAndTheirErrors) {
 
 }  // namespace
 }  // namespace leakmon::model
-
