@@ -71,6 +71,29 @@ double trimmed_t(const std::vector<double>& before, const std::vector<double>& a
   return trimmed_mean / standard_error;
 }
 
+// The share of `before`'s held-out error that `after` removes (the geometric mean above), and
+// the evidence for it: the larger of the plain and the trimmed paired t. Every comparison of two
+// models on held-out data (an effect, a further step, a swap, the stated rig) uses both.
+double held_out_gain(const std::vector<double>& before, const std::vector<double>& after) {
+  return 1.0 - std::exp(-mean_log_ratio(before, after));
+}
+double held_out_evidence(const std::vector<double>& before, const std::vector<double>& after) {
+  return std::max(paired_t(before, after), trimmed_t(before, after));
+}
+
+// The parts of `joint` with the values fitted for them as their starting values: the causes
+// named after a joint fit, each next fit starting where it left them.
+std::vector<EffectCandidate> parts_from_fit(const EffectCandidate& joint,
+                                            const std::vector<double>& values) {
+  const auto shares = joint.split(values);
+  std::vector<EffectCandidate> parts = joint.parts;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    for (std::size_t k = 0; k < shares[p].size(); ++k)
+      parts[p].parameters[k].initial = shares[p][k];
+  }
+  return parts;
+}
+
 std::vector<NamedValue> named_values(const EffectCandidate& c, const FitResult& fit) {
   std::vector<NamedValue> out;
   if (c.effect == "supply_ripple") {
@@ -205,9 +228,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     const auto [corrected_errors, corrected_nrmse] = calibrated_nominal(d.rig_check.assumed);
     d.nrmse_stated = stated_nrmse;
     d.nrmse_corrected = corrected_nrmse;
-    d.rig_score = 1.0 - std::exp(-mean_log_ratio(stated_errors, corrected_errors));
-    d.rig_significance = std::max(paired_t(stated_errors, corrected_errors),
-                                  trimmed_t(stated_errors, corrected_errors));
+    d.rig_score = held_out_gain(stated_errors, corrected_errors);
+    d.rig_significance = held_out_evidence(stated_errors, corrected_errors);
     if (d.rig_score < settings.min_score || d.rig_significance < settings.min_significance ||
         corrected_nrmse >= stated_nrmse) {
       d.rig_rejected = std::move(d.rig_check.findings);
@@ -430,8 +452,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     RankedEffect r;
     r.effect = candidate.effect;
     const auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
-    r.score = 1.0 - std::exp(-mean_log_ratio(nominal_errors, errors));
-    r.significance = std::max(paired_t(nominal_errors, errors), trimmed_t(nominal_errors, errors));
+    r.score = held_out_gain(nominal_errors, errors);
+    r.significance = held_out_evidence(nominal_errors, errors);
     // An effect that starts inside the capture can gain only on the segments that reach its
     // onset: over all of them, the earlier ones' zero gains dilute the paired t and the
     // trimmed t cuts the later ones' gains away as outliers (811067: a droop from 139.6 s of
@@ -707,13 +729,12 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       // as Kv does, entrained air the stiffness as beta does).
       if (adds_bound(fit.parameters.calibration)) continue;
       const auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
-      SelectionStep step{
-          name,
-          predictor.nrmse(fit.parameters, d.held_out_used),
-          1.0 - std::exp(-mean_log_ratio(current_errors, errors)),
-          std::max(paired_t(current_errors, errors), trimmed_t(current_errors, errors)),
-          false,
-          ""};
+      SelectionStep step{name,
+                         predictor.nrmse(fit.parameters, d.held_out_used),
+                         held_out_gain(current_errors, errors),
+                         held_out_evidence(current_errors, errors),
+                         false,
+                         ""};
       if (!best_step || step.score > best_step->score) {
         best_step = step;
         best_joint = std::move(joint);
@@ -750,9 +771,8 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
         const auto refit_errors = segment_errors(predictor, current.parameters, d.held_out_used);
         const auto errors = segment_errors(predictor, best_fit.parameters, d.held_out_used);
         current_nrmse = predictor.nrmse(current.parameters, d.held_out_used);
-        best_step->score = 1.0 - std::exp(-mean_log_ratio(refit_errors, errors));
-        best_step->significance =
-            std::max(paired_t(refit_errors, errors), trimmed_t(refit_errors, errors));
+        best_step->score = held_out_gain(refit_errors, errors);
+        best_step->significance = held_out_evidence(refit_errors, errors);
       }
     }
     // The same for a further effect: the model named so far at a correct model's error leaves
@@ -764,13 +784,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
                           !at_floor(current_nrmse, best_step->nrmse);
     d.steps.push_back(*best_step);
     if (!best_step->accepted) break;
-    const auto shares = best_joint.split(best_fit.values);
-    chosen = best_joint.parts;
-    for (std::size_t p = 0; p < chosen.size(); ++p) {
-      for (std::size_t k = 0; k < shares[p].size(); ++k) {
-        chosen[p].parameters[k].initial = shares[p][k];
-      }
-    }
+    chosen = parts_from_fit(best_joint, best_fit.values);
     current = std::move(best_fit);
   }
 
@@ -783,11 +797,7 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
   // two models have the same causes but one, so the better held-out score decides, as it
   // decides the first cause).
   if (named && chosen.size() >= 2) {
-    const auto score_of = [&](const ModelParameters& p) {
-      return 1.0 - std::exp(-mean_log_ratio(nominal_errors,
-                                            segment_errors(predictor, p, d.held_out_used)));
-    };
-    double current_score = score_of(current.parameters);
+    auto current_errors = segment_errors(predictor, current.parameters, d.held_out_used);
     const double first_alone = winner->score;
     for (const auto& r : d.ranking) {
       if (!r.refined || !r.plausible || r.score < first_alone - settings.swap_score_margin) {
@@ -806,23 +816,16 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       FitResult fit = fit_model(predictor, d.fitting_used, &joint, current.parameters.calibration,
                                 fit_settings);
       if (!joint.plausible(fit.values) || adds_bound(fit.parameters.calibration)) continue;
-      const double swapped_score = score_of(fit.parameters);
-      if (swapped_score <= current_score) continue;
-      const auto before = segment_errors(predictor, current.parameters, d.held_out_used);
-      const auto after = segment_errors(predictor, fit.parameters, d.held_out_used);
-      d.steps.push_back({r.effect, predictor.nrmse(fit.parameters, d.held_out_used),
-                         1.0 - std::exp(-mean_log_ratio(before, after)),
-                         std::max(paired_t(before, after), trimmed_t(before, after)), true,
-                         chosen.front().effect});
-      const auto shares = joint.split(fit.values);
-      chosen = joint.parts;
-      for (std::size_t p = 0; p < chosen.size(); ++p) {
-        for (std::size_t k = 0; k < shares[p].size(); ++k) {
-          chosen[p].parameters[k].initial = shares[p][k];
-        }
+      auto errors = segment_errors(predictor, fit.parameters, d.held_out_used);
+      if (held_out_gain(nominal_errors, errors) <= held_out_gain(nominal_errors, current_errors)) {
+        continue;
       }
+      d.steps.push_back({r.effect, predictor.nrmse(fit.parameters, d.held_out_used),
+                         held_out_gain(current_errors, errors),
+                         held_out_evidence(current_errors, errors), true, chosen.front().effect});
+      chosen = parts_from_fit(joint, fit.values);
       current = std::move(fit);
-      current_score = swapped_score;
+      current_errors = std::move(errors);
     }
   }
 

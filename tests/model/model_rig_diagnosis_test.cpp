@@ -60,9 +60,6 @@ void check_json(const Diagnosis& d, const std::string& name, const std::string& 
   EXPECT_EQ(std::system(command.c_str()), 0) << diagnosis_json(d);
 }
 
-// A healthy rig drawn from MODEL.md's "Other rigs", told its description: `none`. Two rigs per
-// run; the evaluation's rate of `none` on told healthy rigs (docs/model-check.md) makes a run
-// with neither `none` about one in 1000, and a rig_parameter on a told rig was never seen.
 // Several effects at once: forward selection names the best single effect first. Fixed case
 // 817111 of `model evaluate --rigs other --duration 180 --classes pair --seed 817100`: a valve
 // bias (u0 -0.14 V) and a supply droop on a 68 mm rig. Alone the dead band led the bias by 0.005
@@ -86,6 +83,9 @@ TEST(SeveralEffects, ANearTieOfTheFirstCauseTakesItsPlaceWhereItFitsTheOthersBet
              "assert s[0]['effect']=='valve_bias' and s[0]['replaces']=='valve_overlap'");
 }
 
+// A healthy rig drawn from MODEL.md's "Other rigs", told its description: `none`. Two rigs per
+// run; the evaluation's rate of `none` on told healthy rigs (docs/model-check.md) makes a run
+// with neither `none` about one in 1000, and a rig_parameter on a told rig was never seen.
 TEST(OtherRig, HealthyRigToldItsDescriptionIsNone) {
   const auto seed = test::model_test_seed("OtherRig.HealthyRigToldItsDescriptionIsNone");
   int nones = 0;
