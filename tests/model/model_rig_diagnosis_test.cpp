@@ -83,6 +83,45 @@ TEST(SeveralEffects, ANearTieOfTheFirstCauseTakesItsPlaceWhereItFitsTheOthersBet
              "assert s[0]['effect']=='valve_bias' and s[0]['replaces']=='valve_overlap'");
 }
 
+// The runner-up need not be a hair behind: fixed case 817103 of the same evaluation, a valve
+// bias (u0 0.090 V) and a supply droop on a 184 kg, 66 mm rig. Alone the dead band led the bias
+// by 0.022 (0.856 against 0.833), outside the 0.02 the swap first allowed, and the dead band
+// with the droop was named at 2.6 x the true model's held-out error. A runner-up within 0.9 of
+// the first cause's score is tried: the bias and the droop.
+TEST(SeveralEffects, ARunnerUpWithinATenthOfTheFirstCauseIsTriedInItsPlace) {
+  const SyntheticCase c = draw_case(817103, "valve_bias+supply_droop", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.causes.size(), 2u) << causes(d);
+  EXPECT_EQ(d.causes[0].effect, "valve_bias") << causes(d);
+  EXPECT_EQ(d.causes[1].effect, "supply_droop") << causes(d);
+  EXPECT_NEAR(d.causes[0].params.front().value, c.main_value, 0.25 * std::abs(c.main_value));
+  const bool swap_said = std::any_of(d.steps.begin(), d.steps.end(), [](const SelectionStep& s) {
+    return s.accepted && s.effect == "valve_bias" && s.replaces == "valve_overlap";
+  });
+  EXPECT_TRUE(swap_said);
+}
+
+// A further effect's joint fit starts from the calibration the causes named before it left, and
+// that calibration may have soaked up the effect being added. Fixed case 817113 of the same
+// evaluation: a 20.7 ms spool lag beside a leak on a 74 kg, 50 mm rig. Fitted from the leak's
+// calibration, the lag put a calibrated value on its bound and was refused as trading with the
+// calibration; only the leak was named. Restarted from the catalogue calibration it needs no
+// bound: both named, the lag within 25 %.
+TEST(SeveralEffects, AFurtherEffectThatNeedsABoundIsFittedAgainFromTheCatalogue) {
+  const SyntheticCase c = draw_case(817113, "spool_lag+internal_leakage", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.causes.size(), 2u) << causes(d);
+  const auto lag = std::find_if(d.causes.begin(), d.causes.end(),
+                                [](const auto& cause) { return cause.effect == "spool_lag"; });
+  ASSERT_NE(lag, d.causes.end()) << causes(d);
+  EXPECT_NEAR(lag->params.front().value, c.main_value, 0.25 * c.main_value);
+  const bool leak_named = std::any_of(d.causes.begin(), d.causes.end(), [](const auto& cause) {
+    return cause.effect == "internal_leakage";
+  });
+  EXPECT_TRUE(leak_named) << causes(d);
+  EXPECT_TRUE(d.at_bound.empty());
+}
+
 // A healthy rig drawn from MODEL.md's "Other rigs", told its description: `none`. Two rigs per
 // run; the evaluation's rate of `none` on told healthy rigs (docs/model-check.md) makes a run
 // with neither `none` about one in 1000, and a rig_parameter on a told rig was never seen.
