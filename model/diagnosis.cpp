@@ -709,6 +709,20 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
       });
       if (!seen && next.size() < settings.step_candidates) next.push_back(candidate);
     }
+    // The other variants of the effects taken, in screening order: the screening on a few
+    // segments can prefer the wrong channel or chamber by a hair (817201: a 3.8 ms lag of p2
+    // screened behind p1's by 0.4 %; p1's full fit went to its lower bound, implausible, and
+    // the lag was never named). Where a taken variant's full fit is implausible, the next
+    // variant of the same effect is fitted in its place.
+    std::vector<std::size_t> other_variants;
+    for (const auto& ranked : screened_joint) {
+      const std::size_t candidate = ranked.second;
+      if (std::find(next.begin(), next.end(), candidate) != next.end()) continue;
+      const bool of_next = std::any_of(next.begin(), next.end(), [&](std::size_t j) {
+        return library[j].effect == library[candidate].effect;
+      });
+      if (of_next) other_variants.push_back(candidate);
+    }
     std::optional<SelectionStep> best_step;
     EffectCandidate best_joint;
     FitResult best_fit;
@@ -730,6 +744,21 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
                                     within_bounds(catalogue, stated_calibration), fit_settings);
         if (!adds_bound(retry.parameters.calibration) && joint.plausible(retry.values)) {
           fit = std::move(retry);
+        }
+      }
+      if (!joint.plausible(fit.values)) {
+        const auto other = std::find_if(other_variants.begin(), other_variants.end(),
+                                        [&](std::size_t j) { return library[j].effect == name; });
+        if (other != other_variants.end()) {
+          std::vector<EffectCandidate> other_parts = chosen;
+          other_parts.push_back(library[*other]);
+          EffectCandidate other_joint = combine(other_parts);
+          FitResult other_fit = fit_model(predictor, d.fitting_used, &other_joint,
+                                          current.parameters.calibration, fit_settings);
+          if (other_joint.plausible(other_fit.values)) {
+            joint = std::move(other_joint);
+            fit = std::move(other_fit);
+          }
         }
       }
       if (!joint.plausible(fit.values)) continue;
