@@ -106,6 +106,10 @@ struct DiagnosisSettings {
   // nested comparison and the smallest-instance rule now remove (docs/model-check.md).
   std::size_t max_causes = 3;
   std::size_t step_candidates = 4;
+  // A further Coulomb friction is fitted once more from this many times the library's start
+  // of F_C (0: not), from the catalogue calibration: its cost has a minimum near each force
+  // that changes which segments stick.
+  double friction_restart_factor = 3.0;
   double min_step_score = 0.005;
   double min_step_significance = 2.5;
   // Forward selection is greedy: with two or more causes named, an effect whose refined score
