@@ -41,6 +41,13 @@ std::string causes(const Diagnosis& d) {
   return out.empty() ? d.cause : out;
 }
 
+// The cause named for `effect`, or null when it was not named.
+const NamedCause* named_cause(const Diagnosis& d, const std::string& effect) {
+  const auto it = std::find_if(d.causes.begin(), d.causes.end(),
+                               [&](const NamedCause& cause) { return cause.effect == effect; });
+  return it == d.causes.end() ? nullptr : &*it;
+}
+
 Diagnosis diagnose_case(const SyntheticCase& c) {
   const MeasuredRecord record = measured_record(simulate_case(c));
   Diagnosis d = diagnose(record, c.told);
@@ -110,14 +117,10 @@ TEST(SeveralEffects, AFurtherEffectThatNeedsABoundIsFittedAgainFromTheCatalogue)
   const SyntheticCase c = draw_case(817113, "spool_lag+internal_leakage", other_rig(180.0));
   const Diagnosis d = diagnose_case(c);
   ASSERT_EQ(d.causes.size(), 2u) << causes(d);
-  const auto lag = std::find_if(d.causes.begin(), d.causes.end(),
-                                [](const auto& cause) { return cause.effect == "spool_lag"; });
-  ASSERT_NE(lag, d.causes.end()) << causes(d);
+  const NamedCause* lag = named_cause(d, "spool_lag");
+  ASSERT_NE(lag, nullptr) << causes(d);
   EXPECT_NEAR(lag->params.front().value, c.main_value, 0.25 * c.main_value);
-  const bool leak_named = std::any_of(d.causes.begin(), d.causes.end(), [](const auto& cause) {
-    return cause.effect == "internal_leakage";
-  });
-  EXPECT_TRUE(leak_named) << causes(d);
+  EXPECT_NE(named_cause(d, "internal_leakage"), nullptr) << causes(d);
   EXPECT_TRUE(d.at_bound.empty());
 }
 
@@ -131,9 +134,8 @@ TEST(SeveralEffects, AVariantThatFitsImplausiblyGivesWayToTheNextOfTheSameEffect
   const SyntheticCase c = draw_case(817201, "sensor_lag+valve_overlap", other_rig(180.0));
   const Diagnosis d = diagnose_case(c);
   ASSERT_EQ(d.causes.size(), 2u) << causes(d);
-  const auto lag = std::find_if(d.causes.begin(), d.causes.end(),
-                                [](const auto& cause) { return cause.effect == "sensor_lag"; });
-  ASSERT_NE(lag, d.causes.end()) << causes(d);
+  const NamedCause* lag = named_cause(d, "sensor_lag");
+  ASSERT_NE(lag, nullptr) << causes(d);
   const auto tau = std::find_if(lag->params.begin(), lag->params.end(),
                                 [](const NamedValue& v) { return !v.is_text(); });
   ASSERT_NE(tau, lag->params.end());
@@ -142,10 +144,7 @@ TEST(SeveralEffects, AVariantThatFitsImplausiblyGivesWayToTheNextOfTheSameEffect
                                     [](const NamedValue& v) { return v.name == "channel"; });
   ASSERT_NE(channel, lag->params.end());
   EXPECT_EQ(channel->text, "p2");
-  const bool dead_band_named = std::any_of(d.causes.begin(), d.causes.end(), [](const auto& cause) {
-    return cause.effect == "valve_overlap";
-  });
-  EXPECT_TRUE(dead_band_named) << causes(d);
+  EXPECT_NE(named_cause(d, "valve_overlap"), nullptr) << causes(d);
 }
 
 // Coulomb friction's fit has a minimum near each force that changes which segments stick. Fresh
