@@ -847,21 +847,20 @@ Diagnosis diagnose(const MeasuredRecord& record, const sim::RigDescription& rig,
     current = std::move(best_fit);
   }
 
-  // Forward selection keeps its first cause, the best single effect. Where a runner-up lost to
-  // it alone narrowly, the runner-up can be the better partner of the causes named after it
-  // (817111: a valve bias and a supply droop on a 68 mm rig; alone, the dead band led the bias
-  // by 0.005 in score, and the dead band with the droop was named at 2.1 x the true model's
-  // held-out error; 817103, a 184 kg rig, by 0.022 of 0.856). With two or more causes named,
-  // each such runner-up is fitted in the first cause's place beside the others and kept where
-  // it predicts the held-out data better (the two models have the same causes but one, so the
-  // better held-out score decides, as it decides the first cause).
+  // Forward selection keeps its first cause, the best single effect. A runner-up that lost to
+  // it alone can be the better partner of the causes named after it (817111: a valve bias and
+  // a supply droop on a 68 mm rig; alone, the dead band led the bias by 0.005 in score, and the
+  // dead band with the droop was named at 2.1 x the true model's held-out error; 817213, a leak
+  // beside a slow spool on a 48 kg rig, by 0.43 against 0.53). With two or more causes named,
+  // each refined, plausible runner-up is fitted in the first cause's place beside the others
+  // and kept where it predicts the held-out data better (the two models have the same causes
+  // but one, so the better held-out score decides, as it decides the first cause). No window on
+  // the runner-up's score: the held-out score decides, and a window only saved fits (one per
+  // runner-up, where two or more causes are named at all).
   if (named && chosen.size() >= 2) {
     auto current_errors = segment_errors(predictor, current.parameters, d.held_out_used);
-    const double first_alone = winner->score;
     for (const auto& r : d.ranking) {
-      if (!r.refined || !r.plausible || r.score < settings.swap_score_share * first_alone) {
-        continue;
-      }
+      if (!r.refined || !r.plausible || r.score <= 0.0) continue;
       const bool taken = std::any_of(chosen.begin(), chosen.end(),
                                      [&](const auto& c) { return c.effect == r.effect; });
       if (taken || r.effect == "supply_ripple") continue;

@@ -112,10 +112,6 @@ struct DiagnosisSettings {
   double friction_restart_factor = 3.0;
   double min_step_score = 0.005;
   double min_step_significance = 2.5;
-  // Forward selection is greedy: with two or more causes named, an effect whose refined score
-  // alone reached this share of the first cause's is tried in its place with the others, and
-  // kept where that model predicts the held-out data better (docs/model-check.md).
-  double swap_score_share = 0.9;
   // Drift: a parameter fitted on the first and on the last third of the fitting segments that
   // differs by more than `drift_z` standard errors (optimistic ones, docs/model-check.md) and
   // by more than the relative amount (calibration, the first cause's main parameter).

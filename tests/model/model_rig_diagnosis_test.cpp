@@ -101,10 +101,32 @@ TEST(SeveralEffects, ANearTieOfTheFirstCauseTakesItsPlaceWhereItFitsTheOthersBet
 // The runner-up need not be a hair behind: fixed case 817103 of the same evaluation, a valve
 // bias (u0 0.090 V) and a supply droop on a 184 kg, 66 mm rig. Alone the dead band led the bias
 // by 0.022 (0.856 against 0.833), outside the 0.02 the swap first allowed, and the dead band
-// with the droop was named at 2.6 x the true model's held-out error. A runner-up within 0.9 of
-// the first cause's score is tried: the bias and the droop.
-TEST(SeveralEffects, ARunnerUpWithinATenthOfTheFirstCauseIsTriedInItsPlace) {
+// with the droop was named at 2.6 x the true model's held-out error: the bias and the droop.
+TEST(SeveralEffects, ARunnerUpANarrowMarginBehindIsTriedInItsPlace) {
   expect_the_bias_swapped_in_for_the_dead_band(817103);
+}
+
+// Nor within a tenth: fresh case 817213 of `model evaluate --rigs other --duration 180 --classes
+// pair --seed 817200`, a leak of 1.13e-12 beside a 27 ms spool lag on a 48 kg, 38 mm rig (its
+// own spool 10.7 ms). Alone the dead band scored 0.533 and the leak 0.431 (0.81 of it, outside
+// the 0.9 the swap then allowed); the dead band and the lag were named. Every refined,
+// plausible runner-up is now tried: the leak and the lag, each within 25 %, the swap said.
+TEST(SeveralEffects, ARunnerUpFarBehindAloneIsTriedInItsPlace) {
+  const SyntheticCase c = draw_case(817213, "spool_lag+internal_leakage", other_rig(180.0));
+  const Diagnosis d = diagnose_case(c);
+  ASSERT_EQ(d.causes.size(), 2u) << causes(d);
+  const NamedCause* lag = named_cause(d, "spool_lag");
+  const NamedCause* leak = named_cause(d, "internal_leakage");
+  ASSERT_NE(lag, nullptr) << causes(d);
+  ASSERT_NE(leak, nullptr) << causes(d);
+  EXPECT_NEAR(lag->params.front().value, c.main_value, 0.25 * c.main_value);
+  ASSERT_EQ(c.effects.size(), 2u);
+  ASSERT_EQ(c.effects[1].effect, "internal_leakage");
+  EXPECT_NEAR(leak->params.front().value, c.effects[1].main_value, 0.25 * c.effects[1].main_value);
+  const bool swap_said = std::any_of(d.steps.begin(), d.steps.end(), [](const SelectionStep& s) {
+    return s.accepted && s.effect == "internal_leakage" && s.replaces == "valve_overlap";
+  });
+  EXPECT_TRUE(swap_said);
 }
 
 // A further effect's joint fit starts from the calibration the causes named before it left, and
