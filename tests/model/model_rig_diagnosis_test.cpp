@@ -48,6 +48,13 @@ const NamedCause* named_cause(const Diagnosis& d, const std::string& effect) {
   return it == d.causes.end() ? nullptr : &*it;
 }
 
+// Whether the steps say that `effect` was accepted in the place of `replaces`.
+bool swap_said(const Diagnosis& d, const std::string& effect, const std::string& replaces) {
+  return std::any_of(d.steps.begin(), d.steps.end(), [&](const SelectionStep& s) {
+    return s.accepted && s.effect == effect && s.replaces == replaces;
+  });
+}
+
 Diagnosis diagnose_case(const SyntheticCase& c) {
   const MeasuredRecord record = measured_record(simulate_case(c));
   Diagnosis d = diagnose(record, c.told);
@@ -77,10 +84,7 @@ Diagnosis expect_the_bias_swapped_in_for_the_dead_band(std::uint64_t seed) {
   if (!d.causes.empty() && !d.causes[0].params.empty()) {
     EXPECT_NEAR(d.causes[0].params.front().value, c.main_value, 0.25 * std::abs(c.main_value));
   }
-  const bool swap_said = std::any_of(d.steps.begin(), d.steps.end(), [](const SelectionStep& s) {
-    return s.accepted && s.effect == "valve_bias" && s.replaces == "valve_overlap";
-  });
-  EXPECT_TRUE(swap_said);
+  EXPECT_TRUE(swap_said(d, "valve_bias", "valve_overlap"));
   return d;
 }
 
@@ -123,10 +127,7 @@ TEST(SeveralEffects, ARunnerUpFarBehindAloneIsTriedInItsPlace) {
   ASSERT_EQ(c.effects.size(), 2u);
   ASSERT_EQ(c.effects[1].effect, "internal_leakage");
   EXPECT_NEAR(leak->params.front().value, c.effects[1].main_value, 0.25 * c.effects[1].main_value);
-  const bool swap_said = std::any_of(d.steps.begin(), d.steps.end(), [](const SelectionStep& s) {
-    return s.accepted && s.effect == "internal_leakage" && s.replaces == "valve_overlap";
-  });
-  EXPECT_TRUE(swap_said);
+  EXPECT_TRUE(swap_said(d, "internal_leakage", "valve_overlap"));
 }
 
 // A further effect's joint fit starts from the calibration the causes named before it left, and
