@@ -99,7 +99,9 @@ int run_evaluate(int argc, char** argv) {
               "paper: the paper's rig across MODEL.md's calibration spread; other: each run on a "
               "rig drawn from MODEL.md \"Other rigs\", leak sizes relative to its valve (C_L = "
               "size x Kv / 3.39e-7), the default detector on three sets of channels told the rig "
-              "and not told; writes rigs.md, rigs.tsv and rigs_runs.tsv (stationary runs only)",
+              "and not told; writes rigs.md, rigs.tsv and rigs_runs.tsv (and with programs or "
+              "wear their tables per phase kind and growth rate; not with restart or sensor "
+              "faults; programs scaled as the rig's steps, supply changes as its supply)",
               "paper")
       .option("keep-captures", "IDS", "write these runs' captures (run-ID.csv), comma-separated",
               "")
@@ -152,11 +154,20 @@ int run_evaluate(int argc, char** argv) {
   if (settings.rigs != "paper" && settings.rigs != "other") {
     throw UsageError(fmt::format("option '--rigs': '{}' is not paper or other", settings.rigs));
   }
-  if (settings.rigs == "other" && (settings.conditions != std::vector<std::string>{"stationary"} ||
-                                   settings.sensor_fault_runs > 0)) {
-    throw UsageError(
-        "--rigs other runs stationary conditions only (drop --conditions and "
-        "--sensor-fault-runs)");
+  if (settings.rigs == "other") {
+    // The rig runner replays one capture per run: a restart's second capture and the sensor
+    // fault tables are the paper's rig's.
+    for (const auto& condition : settings.conditions) {
+      if (condition == "restart" || condition == "sensor-faults") {
+        throw UsageError(fmt::format(
+            "--rigs other does not run the '{}' condition (known there: stationary, warmup, "
+            "cooler, supply, programs, wear)",
+            condition));
+      }
+    }
+    if (settings.sensor_fault_runs > 0) {
+      throw UsageError("--rigs other does not run --sensor-fault-runs");
+    }
   }
   for (double id : parse_list("keep-captures", args.get("keep-captures"))) {
     settings.keep_captures.push_back(static_cast<int>(id));

@@ -150,7 +150,7 @@ int run_evaluate_cases(int argc, char** argv) {
     if (args.flag_set("keep-captures")) {
       const model::SyntheticCase c = model::draw_case(seed, effect, settings);
       capture::write_capture(fmt::format("{}/case-{}.csv", dir, seed), model::simulate_case(c));
-      write_text(fmt::format("{}/case-{}-rig.yaml", dir, seed), model::rig_file_text(c.told));
+      write_text(fmt::format("{}/case-{}-rig.yaml", dir, seed), sim::rig_file_text(c.told));
     }
     summary.cases.push_back(model::evaluate_case(seed, effect, settings));
     summary.cases.back().kind = kind;

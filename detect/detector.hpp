@@ -60,10 +60,11 @@ enum class NotJudgedReason {
   outside_learned_regime,  // pressure-only: the program excites the mode unlike any learned one
   data_gap,                // the observations lack a signal the detector needs
   sensor_fault,            // a channel is faulty or suspect: the detector is not fed
+  detection_blind,         // pressure-only: the rig's hydraulic mode does not show (the daemon's)
 };
 
 // The names the daemon uses for the reasons (/status, metrics labels, events), in enum order.
-inline constexpr std::array<std::string_view, 12> kNotJudgedReasonNames = {"none",
+inline constexpr std::array<std::string_view, 13> kNotJudgedReasonNames = {"none",
                                                                            "learning",
                                                                            "waiting_for_excitation",
                                                                            "cannot_learn",
@@ -74,7 +75,8 @@ inline constexpr std::array<std::string_view, 12> kNotJudgedReasonNames = {"none
                                                                            "no_excitation",
                                                                            "outside_learned_regime",
                                                                            "data_gap",
-                                                                           "sensor_fault"};
+                                                                           "sensor_fault",
+                                                                           "detection_blind"};
 
 constexpr std::string_view to_string(NotJudgedReason reason) {
   return kNotJudgedReasonNames[static_cast<std::size_t>(reason)];

@@ -439,6 +439,11 @@ std::vector<Option<FlowLawOptions>> flow_law_rows() {
              number_option<O>("supply_rest_seconds", 0.0, 60.0,
                               "without `ps`: ... once they have been for this long [s]",
                               [](O& o) -> double& { return o.supply_rest_seconds; }),
+             number_option<O>("supply_motion_seconds", 0.0, 600.0,
+                              "without `ps`: with no rest read for this long, the mean of p1 + p2 "
+                              "- pt over it reads the supply (in motion the lands balance on "
+                              "average) [s]; 0: rests only",
+                              [](O& o) -> double& { return o.supply_motion_seconds; }),
              judged_memory_option<O>()} +
          drift_options<O>(1.0) + estimate_supply_options<O>() + oil_options<O>();
 }

@@ -82,6 +82,11 @@ struct FlowLawOptions {
   double drift_window_seconds = 120.0;
   double rest_speed = 2e-3;  // [m/s] hops slower than this read the supply from the chambers ...
   double supply_rest_seconds = 0.2;  // ... once they have been for this long [s]
+  // ... and when no rest has been read for this long, the mean of p1 + p2 - pt over that time
+  // is a reading too: in motion the double-rod actuator's chambers take and give the same flow,
+  // so the lands' pressure drops balance on average (a sine, sweep or triangle block never rests;
+  // the paper's steps rest every few seconds). 0: rests only [s].
+  double supply_motion_seconds = 5.0;
   bool estimate_supply = true;
   // Learn the spool's time constant from the learning blocks (a ladder of kTauCandidates values,
   // a third of an octave apart around rig.tau); false keeps rig.tau.
@@ -156,6 +161,8 @@ class FlowLawDetector final : public Detector {
   // How often motion resuming after a wait at rest started the learning period over since
   // construction, reset or restore (diagnostics and tests; not saved).
   std::size_t learning_restarts() const { return learning_restarts_; }
+  // The supply the flows are integrated with now [Pa] (the stated one before any reading).
+  double supply() const { return supply_tracker_.estimate(); }
   // How often a leak that opened while learning was left out of the learning and judged
   // (learn_before_change) since construction, reset or restore (diagnostics; not saved).
   std::size_t changes_judged_after_learning() const { return changes_judged_after_learning_; }
@@ -171,8 +178,9 @@ class FlowLawDetector final : public Detector {
   // Layout 5 adds the null-offset regressor (layout 4's learning blocks load without it, and
   // learning then fits without it as the build that wrote them would; its coefficient is 0).
   // Layout 6 adds the learned range: (X'X)^-1 and the largest learning leverage (layout 5 loads
-  // without them and judges every block, as its build did).
-  static constexpr int kStateVersion = 6;
+  // without them and judges every block, as its build did). Layout 7 reads the supply in motion
+  // too (`supply_motion.*`; layout 6 loads reading it at rest only, as its build did).
+  static constexpr int kStateVersion = 7;
   // Motion alone identifies the load term only when at least this share of the learning blocks
   // move: a long hold with a few seconds of a sweep has a sharp but biased load term.
   static constexpr double kMotionBlockShare = 0.75;
@@ -271,7 +279,8 @@ class FlowLawDetector final : public Detector {
   double design_slope_;  // design_leak in the load regressor's units (before a)
   double floor_slope_;
   double sizing_decay_;
-  std::size_t rest_hops_;  // supply_rest_seconds in hops
+  std::size_t rest_hops_;    // supply_rest_seconds in hops
+  std::size_t motion_hops_;  // supply_motion_seconds in hops (0: off)
   LearningClock clock_;
   std::vector<Block> learned_;  // reserved at construction; the newest when waiting
   std::size_t learn_capacity_;
@@ -305,6 +314,14 @@ class FlowLawDetector final : public Detector {
   double sample_seconds_ = kMissing;
   double previous_x_ = kMissing;  // hop mean, for the rest test of the supply estimate
   std::size_t still_hops_ = 0;    // consecutive hops at rest, for the same
+  // The supply read in motion: p1 + p2 - pt summed over the hops since the last reading, and
+  // whether this state reads it (a state of layout 6 or before does not, as its build did not).
+  double motion_supply_sum_ = 0.0;
+  std::size_t motion_supply_hops_ = 0;
+  bool reads_supply_in_motion_ = true;
+  // A first reading of the supply that differs from the stated one by a step: the learning
+  // blocks so far were integrated with the wrong supply and are dropped.
+  void restart_learning_on_first_supply(double reading);
   // The time-constant ladder: kTauNotChosen while every candidate is integrated.
   std::array<double, kTauCandidates> taus_{};
   std::size_t tau_index_ = kTauNotChosen;

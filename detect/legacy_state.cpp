@@ -221,6 +221,17 @@ DetectorState flow_law_from_5(const DetectorState& old) {
   return out;
 }
 
+// flow_law 6 read the supply at rest only: it loads reading it so, as its build did (a reset
+// reads it in motion too).
+DetectorState flow_law_from_6(const DetectorState& old) {
+  DetectorState out(old.kind(), 7);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  out.put("supply_motion.sum", 0.0);
+  out.put("supply_motion.hops", 0.0);
+  out.put("supply_motion.read", 0.0);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -484,6 +495,9 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() < 7 && version == 7) {
+      return flow_law_from_6(upgraded_state(state, kind, 6));
+    }
     if (kind == "flow_law" && state.version() < 6 && version == 6) {
       return flow_law_from_5(upgraded_state(state, kind, 5));
     }

@@ -6,7 +6,9 @@
 //   flow_law 1 (before it learned the spool's time constant: loaded with the stated one kept)
 //   and 2 (before the supply waited for a settled rest and the CUSUM's run was kept for the
 //   change point: read as then until the piston moves, with an empty run) and 3 (before the
-//   learning blocks at rest were told from those that move: its blocks load as moving);
+//   learning blocks at rest were told from those that move: its blocks load as moving), 4, 5
+//   and 6 (before the null offset, the learned range and the supply read in motion: each loads
+//   without it);
 //   fused 1 is unchanged (its members' states carry their own layouts); and index_cusum 4 and
 //   detail_xcorr 2, written before the feature test waited for excitation and judged in the
 //   learned regime only (issue 23): converted with neither (they judge as they did until reset);

@@ -49,6 +49,7 @@ class SupplyTracker {
 
   // The supply to use [Pa]: the estimate, or the configured supply before any reading.
   double estimate() const { return std::isnan(estimate_) ? options_.configured : estimate_; }
+  bool has_reading() const { return !std::isnan(estimate_); }
   double step_time() const { return step_time_; }  // the last step, NaN when none
   // No step within kSupplyTransientSeconds before t.
   bool settled(double t) const {

@@ -220,21 +220,6 @@ SyntheticCase draw_case(std::uint64_t seed, const std::string& effect,
 
 capture::Capture simulate_case(const SyntheticCase& c) { return sim::simulate(c.scenario); }
 
-std::string rig_file_text(const sim::RigDescription& rig) {
-  std::string out = fmt::format("# {}\nrig:\n", sim::describe(rig));
-  for (const auto& key : sim::rig_keys()) {
-    if (key.symbol.empty()) continue;  // the valve's rating and the oil: below
-    out += fmt::format("  {}: {:.9g}\n", key.key, *sim::rig_value(rig, key.key));
-  }
-  if (const auto grade = sim::rig_value(rig, "oil_grade")) {
-    out += fmt::format("  oil_grade: {:g}\n", *grade);
-  } else {
-    out += fmt::format("  oil_viscosity_40: {:.9g}\n  oil_viscosity_100: {:.9g}\n", rig.oil.nu40(),
-                       rig.oil.nu100());
-  }
-  return out;
-}
-
 ModelParameters true_model(const SyntheticCase& c) {
   const auto& s = c.scenario;
   ModelParameters m;

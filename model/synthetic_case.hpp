@@ -69,9 +69,6 @@ const std::vector<Misstatement>& misstatements();
 SyntheticCase draw_case(std::uint64_t seed, const std::string& effect = "",
                         const CaseSettings& settings = {});
 capture::Capture simulate_case(const SyntheticCase& c);
-// The description a case tells the model check, as a file `leakmon model check --rig` reads:
-// every key with a value of its own (MODEL.md's symbols and the oil's grade or viscosities).
-std::string rig_file_text(const sim::RigDescription& rig);
 // The generator's own model of the case (the "true model" whose held-out NRMSE is the best
 // any extension can reach).
 ModelParameters true_model(const SyntheticCase& c);

@@ -458,7 +458,16 @@ void ActuatorMonitor::decide(double t, const EventPublisher& publish) {
       reason = detect::NotJudgedReason::no_excitation;
     }
   }
+  // A pressure-only detector on a rig whose mode does not show reads no leak: its score moves
+  // with whatever else the index holds (the program's excitation on a rig ringing at 6-46 Hz),
+  // so it neither judges nor raises (the detection_blind event said so once).
+  const bool blind = detection_blind();
+  if (blind && !last_decision_.learning) {
+    judged = false;
+    reason = detect::NotJudgedReason::detection_blind;
+  }
   track_judging(t, judged, reason, publish);
+  if (blind) return;
 
   const AlarmTransition transition = alarm_.update(last_decision_.score, t);
   if (transition.raised) publish(alarm_event(io::EventKind::alarm_raised, t));

@@ -244,4 +244,19 @@ std::string describe(const RigDescription& rig) {
   return text;
 }
 
+std::string rig_file_text(const RigDescription& rig) {
+  std::string out = fmt::format("# {}\nrig:\n", describe(rig));
+  for (const auto& key : rig_keys()) {
+    if (key.symbol.empty()) continue;  // the valve's rating and the oil: below
+    out += fmt::format("  {}: {:.9g}\n", key.key, *rig_value(rig, key.key));
+  }
+  if (const auto grade = rig_value(rig, "oil_grade")) {
+    out += fmt::format("  oil_grade: {:g}\n", *grade);
+  } else {
+    out += fmt::format("  oil_viscosity_40: {:.9g}\n  oil_viscosity_100: {:.9g}\n", rig.oil.nu40(),
+                       rig.oil.nu100());
+  }
+  return out;
+}
+
 }  // namespace leakmon::sim

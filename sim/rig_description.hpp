@@ -76,4 +76,8 @@ RigDescription with_value(const RigDescription& rig, std::string_view key, doubl
 // with the stated keys only, or "the paper's rig (MODEL.md nominal)" when nothing is stated.
 std::string describe(const RigDescription& rig);
 
+// The description as a file `leakmon model check --rig` and `leakmon replay --rig` read: every
+// key with a value of its own (MODEL.md's symbols and the oil's grade or viscosities).
+std::string rig_file_text(const RigDescription& rig);
+
 }  // namespace leakmon::sim

@@ -88,6 +88,40 @@ void describe_program(RunSpec& run) {
   }
 }
 
+// A program (MODEL.md "Test programs") the run's rig can run. On the paper's rig as drawn. On
+// another rig its positions and amplitudes scale as the rig's steps do (a rig whose valve or load
+// cannot make the paper's 50 mm moves makes smaller ones), and it is drawn again while the rig
+// cannot run it (sim::check_viability on the program with each phase cut to kViabilitySeconds;
+// after kProgramDraws tries at half the amplitudes, and so on).
+std::vector<sim::Phase> draw_program_for_rig(std::mt19937_64& rng, const EvaluationOptions& options,
+                                             std::optional<sim::PhaseKind> leak_kind,
+                                             const sim::Scenario& s, int& leak_phase) {
+  if (options.rigs != "other") {
+    return sim::draw_program(rng, options.time_scale, leak_kind, leak_phase);
+  }
+  constexpr int kProgramDraws = 6;
+  constexpr double kViabilitySeconds = 20.0;
+  double scale = s.reference.amp_max / sim::ReferenceSettings{}.amp_max;
+  sim::Scenario trial = s;
+  trial.effects = sim::Effects{};
+  for (int attempt = 1;; ++attempt) {
+    std::vector<sim::Phase> program =
+        sim::draw_program(rng, options.time_scale, leak_kind, leak_phase);
+    for (auto& phase : program) {
+      phase.X *= scale;
+      phase.A *= scale;
+    }
+    trial.program = program;
+    for (auto& phase : trial.program)
+      phase.duration_s = std::min(phase.duration_s, kViabilitySeconds);
+    trial.duration_s = sim::program_seconds(trial.program);
+    if (attempt >= 4 * kProgramDraws || sim::check_viability(trial, trial.duration_s).ok) {
+      return program;
+    }
+    if (attempt % kProgramDraws == 0) scale *= 0.5;
+  }
+}
+
 // programs: a random program on the stationary rig. A healthy run lasts as long as its program;
 // a leak run opens its leak inside the phase of the planned kind, 20 s or more after learning,
 // in the phase's first part (detect_within before its end where the phase is that long), and
@@ -103,7 +137,7 @@ void apply_program(std::mt19937_64& rng, const EvaluationOptions& options, RunSp
                     : sim::kPhaseKinds[std::uniform_int_distribution<std::size_t>(0, 4)(rng)];
   }
   int j = -1;
-  s.program = sim::draw_program(rng, options.time_scale, leak_kind, j);
+  s.program = draw_program_for_rig(rng, options, leak_kind, s, j);
   s.duration_s = sim::program_seconds(s.program);
   if (j >= 0) {
     const auto at = static_cast<std::size_t>(j);
@@ -169,7 +203,7 @@ void apply_operating(const std::string& operating, std::mt19937_64& rng, double 
     if (operating == "wear" && run.leak > 0.0) {
       // A seal that wears (MODEL.md "Test programs"): C_L from 0 at the onset to 1e-12..5e-12
       // over 10 min to 4 h (log-uniform), the run going on after it for the condition's time.
-      run.leak = uniform(rng, 1e-12, 5e-12);
+      run.leak = uniform(rng, 1e-12, 5e-12) * run.valve_scale;
       run.wear_seconds =
           std::exp(uniform(rng, std::log(600.0), std::log(14400.0))) * options.time_scale;
       const double after = s.duration_s - run.onset;
@@ -182,7 +216,9 @@ void apply_operating(const std::string& operating, std::mt19937_64& rng, double 
     for (int i = 0; i < changes && t < healthy_to; ++i) {
       t = uniform(rng, t + 10.0, std::max(t + 10.0, healthy_to - 30.0));
       const double ramp = uniform(rng, 0.0, 5.0);
-      s.conditions.supply.push_back({t, uniform(rng, 13e6, 20e6), ramp});
+      // MODEL.md's 13-20 MPa around the paper's 17.2, as that share of another rig's supply.
+      const double share = s.params.ps / sim::Parameters{}.ps;
+      s.conditions.supply.push_back({t, share * uniform(rng, 13e6, 20e6), ramp});
       t += ramp;
     }
   } else if (operating == "sensor-faults" && !run.sensor_fault_run) {
@@ -299,8 +335,9 @@ void use_other_rig(RunSpec& run) {
   s.reference = other.reference;
   s.sensors = other.sensors;
   s.name += "-other-rig";
+  run.valve_scale = s.params.Kv / kPaperValveCoefficient;
   if (run.leak > 0.0) {
-    run.leak *= s.params.Kv / kPaperValveCoefficient;
+    run.leak *= run.valve_scale;
     if (s.effects.internal_leakage) s.effects.internal_leakage->C_L = run.leak;
   }
 }

@@ -98,6 +98,9 @@ struct RunSpec {
   // the generic tables.
   double wear_seconds = NAN;
   bool wear_run() const { return !std::isnan(wear_seconds); }
+  // The run's valve against the paper's (Kv / kPaperValveCoefficient on another rig, 1 on the
+  // paper's): leak sizes are drawn and scored as that share of the valve's flow.
+  double valve_scale = 1.0;
   // The C_L [m^3/(s Pa)] in force at t.
   double leak_at(double t) const;
   // Index into `phases` of the phase that holds t (-1 without a program or outside it).

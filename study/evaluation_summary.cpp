@@ -282,7 +282,8 @@ double PhaseKindScore::false_alarms_per_hour_upper_95() const {
 }
 
 std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& results,
-                                                 std::size_t candidate, double detect_within) {
+                                                 std::size_t candidate, double detect_within,
+                                                 std::optional<std::size_t> threshold) {
   // Rows: the five kinds with the holds that cannot be judged after the holds.
   std::vector<PhaseKindScore> rows;
   for (const sim::PhaseKind kind : sim::kPhaseKinds) {
@@ -296,7 +297,7 @@ std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& r
     return *std::find_if(rows.begin(), rows.end(),
                          [&](const PhaseKindScore& row) { return row.phase == name; });
   };
-  const std::size_t t = design_index(candidates()[candidate]);
+  const std::size_t t = threshold.value_or(design_index(candidates()[candidate]));
   for (const auto& r : results) {
     const RunSpec& spec = r.spec;
     if (spec.phases.empty() || spec.sensor_fault_run || spec.wear_run()) continue;
@@ -341,9 +342,10 @@ std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& r
 }
 
 std::vector<ProgramStartScore> score_program_starts(const std::vector<RunResult>& results,
-                                                    std::size_t candidate) {
+                                                    std::size_t candidate,
+                                                    std::optional<std::size_t> threshold) {
   std::vector<ProgramStartScore> rows = {{.starts_with_hold = true}, {.starts_with_hold = false}};
-  const std::size_t t = design_index(candidates()[candidate]);
+  const std::size_t t = threshold.value_or(design_index(candidates()[candidate]));
   for (const auto& r : results) {
     const RunSpec& spec = r.spec;
     if (spec.phases.empty() || spec.sensor_fault_run || spec.wear_run()) continue;
@@ -359,20 +361,21 @@ std::vector<ProgramStartScore> score_program_starts(const std::vector<RunResult>
   return rows;
 }
 
-std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate) {
+std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate,
+                                  std::optional<std::size_t> threshold) {
   std::vector<WearScore> rows = {
       {.growth = "all"}, {.growth = "slow"}, {.growth = "medium"}, {.growth = "fast"}};
-  const std::size_t t = design_index(candidates()[candidate]);
+  const std::size_t t = threshold.value_or(design_index(candidates()[candidate]));
   for (const auto& r : results) {
     const RunSpec& spec = r.spec;
     if (!spec.wear_run() || spec.leak <= 0.0) continue;
-    const double per_hour = spec.leak / (spec.wear_seconds / 3600.0);
+    const double per_hour = spec.leak / spec.valve_scale / (spec.wear_seconds / 3600.0);
     WearScore& band = rows[per_hour < kWearSlow ? 1 : per_hour < kWearFast ? 2 : 3];
     for (WearScore* row : {&rows[0], &band}) {
       ++row->runs;
       for (const auto& a : r.alarms[candidate][t]) {
         if (a.raised < spec.onset) continue;
-        const double size = spec.leak_at(a.raised);
+        const double size = spec.leak_at(a.raised) / spec.valve_scale;
         ++row->found;
         row->found_before_target += size <= kWearTarget ? 1 : 0;
         row->found_at.push_back(size);

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -124,8 +125,11 @@ struct PhaseKindScore {
   double false_alarms_per_hour() const;
   double false_alarms_per_hour_upper_95() const;  // NaN without healthy time
 };
+// `threshold`: the index into a run's alarms of the candidate (its design threshold's when
+// absent; the rig evaluation's runs hold one list per candidate).
 std::vector<PhaseKindScore> score_program_phases(const std::vector<RunResult>& results,
-                                                 std::size_t candidate, double detect_within);
+                                                 std::size_t candidate, double detect_within,
+                                                 std::optional<std::size_t> threshold = {});
 
 // Program runs split by how the program starts (with a hold or not): their healthy time and
 // false alarms, for one candidate at its design threshold.
@@ -136,12 +140,14 @@ struct ProgramStartScore {
   int false_alarms = 0;
 };
 std::vector<ProgramStartScore> score_program_starts(const std::vector<RunResult>& results,
-                                                    std::size_t candidate);
+                                                    std::size_t candidate,
+                                                    std::optional<std::size_t> threshold = {});
 
 // Seals that wear (the `wear` condition), one candidate at its design threshold: the C_L in force
 // at the first raise after the onset, and whether that came before C_L passed kWearTarget.
 // Grouped by growth rate C_L / wear time: slow (below kWearSlow per hour), medium, fast (at or
-// above kWearFast per hour), and all.
+// above kWearFast per hour), and all. Sizes and rates are the paper's valve's equivalent
+// (C_L / RunSpec::valve_scale), so another rig's wear is judged as the same share of its flow.
 inline constexpr double kWearTarget = 1.5e-12;  // m^3/(s Pa)
 inline constexpr double kWearSlow = 1e-12;      // m^3/(s Pa) per hour
 inline constexpr double kWearFast = 1e-11;      // m^3/(s Pa) per hour
@@ -150,7 +156,8 @@ struct WearScore {
   int runs = 0, found = 0, found_before_target = 0;
   std::vector<double> found_at = {};  // C_L at the first raise after the onset [m^3/(s Pa)]
 };
-std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate);
+std::vector<WearScore> score_wear(const std::vector<RunResult>& results, std::size_t candidate,
+                                  std::optional<std::size_t> threshold = {});
 
 // The controller groups the summaries report: "all" and each controller.
 inline constexpr std::array<std::string_view, 3> kControllerGroups = {"all", "basic",

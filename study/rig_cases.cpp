@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <variant>
 
 #include "pipeline/mode_visibility.hpp"
@@ -50,6 +51,97 @@ std::string found_text(const Rates& r) {
 std::string size_error_text(const Rates& r) {
   const double e = r.median_abs_size_error();
   return std::isfinite(e) ? fmt::format("{:.0f} %", 100.0 * e) : "-";
+}
+
+std::string candidate_label(const RigCandidate& c) {
+  return fmt::format("{} ({})", c.label, c.told ? "told" : "not told");
+}
+
+std::string percent_of(int k, int n) {
+  if (n == 0) return "-";
+  return fmt::format("{}/{} ({:.0f} %)", k, n, 100.0 * k / n);
+}
+
+// Test programs and seals that wear on other rigs: rigs.md's tables per phase kind, per program
+// start and per growth rate for every candidate, and rigs_programs.tsv / rigs_wear.tsv.
+void write_rig_condition_tables(fmt::ostream& md, const std::filesystem::path& dir,
+                                const EvaluationOptions& options,
+                                const std::vector<RigRunResult>& results) {
+  std::vector<RunResult> runs;
+  bool programs = false, wear = false;
+  for (const auto& r : results) {
+    runs.push_back(r.run);
+    programs = programs || (!r.run.spec.phases.empty() && !r.run.spec.wear_run());
+    wear = wear || (r.run.spec.wear_run() && r.run.spec.leak > 0.0);
+  }
+  const auto all = rig_candidates();
+  if (programs) {
+    auto tsv = fmt::output_file((dir / "rigs_programs.tsv").string());
+    tsv.print(
+        "channels\ttold\tphase\thealthy_hours\tfalse_alarms\tfa_upper_95\tleak_runs\tfound\t"
+        "found_late\tmedian_delay\n");
+    md.print(
+        "\nTest programs per phase kind (the phases' positions and amplitudes scaled as the rig's "
+        "steps). Healthy time: monitored, before any onset, in phases of the kind; a false alarm "
+        "counts in the phase it was raised in. A leak counts in the phase it opened in and is "
+        "found when raised within {0:.0f} s of its onset, or, in a hold whose |K_s X| / A stays "
+        "below {1:g} MPa (not judgeable), within {0:.0f} s of the next phase's start.\n\n"
+        "| channels | phase | healthy h | false alarms (95 % upper bound per h) | leaks found in "
+        "time | found later | median delay |\n|---|---|---|---|---|---|---|\n",
+        options.detect_within, kJudgeableLoad / 1e6);
+    for (std::size_t c = 0; c < all.size(); ++c) {
+      for (const PhaseKindScore& row : score_program_phases(runs, c, options.detect_within, 0)) {
+        if (row.healthy_hours <= 0.0 && row.leak_runs == 0) continue;
+        md.print("| {} | {} | {:.2f} | {} ({:.2f}) | {} | {} | {} |\n", candidate_label(all[c]),
+                 row.phase, row.healthy_hours, row.false_alarms,
+                 row.false_alarms_per_hour_upper_95(), percent_of(row.found, row.leak_runs),
+                 row.found_late, delay_text(row.delays));
+        std::vector<double> delays = row.delays;
+        std::sort(delays.begin(), delays.end());
+        tsv.print("{}\t{}\t{}\t{:.4g}\t{}\t{:.4g}\t{}\t{}\t{}\t{:.4g}\n", all[c].label,
+                  all[c].told ? 1 : 0, row.phase, row.healthy_hours, row.false_alarms,
+                  row.false_alarms_per_hour_upper_95(), row.leak_runs, row.found, row.found_late,
+                  delays.empty() ? NAN : delays[delays.size() / 2]);
+      }
+    }
+    md.print(
+        "\nBy how the program starts:\n\n| channels | program starts with | runs | healthy h | "
+        "false alarms | runs with a false alarm |\n|---|---|---|---|---|---|\n");
+    for (std::size_t c = 0; c < all.size(); ++c) {
+      for (const ProgramStartScore& row : score_program_starts(runs, c, 0)) {
+        md.print("| {} | {} | {} | {:.2f} | {} | {} |\n", candidate_label(all[c]),
+                 row.starts_with_hold ? "a hold" : "another phase", row.runs, row.healthy_hours,
+                 row.false_alarms, row.runs_with_false_alarm);
+      }
+    }
+  }
+  if (wear) {
+    auto tsv = fmt::output_file((dir / "rigs_wear.tsv").string());
+    tsv.print("channels\ttold\tgrowth\truns\tfound\tfound_before_target\tmedian_found_at\n");
+    md.print(
+        "\nSeals that wear (C_L from 0 to 1e-12..5e-12 x Kv / 3.39e-7 over 10 min to 4 h; sizes "
+        "as the paper's valve's equivalent, C_L x 3.39e-7 / Kv; found = the first raise after the "
+        "wear began):\n\n| channels | found | found before {:g} | median size when found | slow "
+        "| medium | fast |\n|---|---|---|---|---|---|---|\n",
+        kWearTarget);
+    for (std::size_t c = 0; c < all.size(); ++c) {
+      const std::vector<WearScore> rows = score_wear(runs, c, 0);
+      std::vector<double> sizes = rows[0].found_at;
+      std::sort(sizes.begin(), sizes.end());
+      md.print("| {} | {}/{} | {} | {} | {}/{} | {}/{} | {}/{} |\n", candidate_label(all[c]),
+               rows[0].found, rows[0].runs, percent_of(rows[0].found_before_target, rows[0].runs),
+               sizes.empty() ? std::string("-") : fmt::format("{:.2g}", sizes[sizes.size() / 2]),
+               rows[1].found_before_target, rows[1].runs, rows[2].found_before_target, rows[2].runs,
+               rows[3].found_before_target, rows[3].runs);
+      for (const WearScore& row : rows) {
+        std::vector<double> at = row.found_at;
+        std::sort(at.begin(), at.end());
+        tsv.print("{}\t{}\t{}\t{}\t{}\t{}\t{:.4g}\n", all[c].label, all[c].told ? 1 : 0, row.growth,
+                  row.runs, row.found, row.found_before_target,
+                  at.empty() ? NAN : at[at.size() / 2]);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -124,6 +216,9 @@ RigRunResult evaluate_rig_run(const RunSpec& spec, const EvaluationOptions& opti
   if (std::find(options.keep_captures.begin(), options.keep_captures.end(), spec.id) !=
       options.keep_captures.end()) {
     capture::write_capture((options.out / fmt::format("run-{}.csv", spec.id)).string(), capture);
+    // The rig it ran on, for `leakmon replay --rig` (told) beside the plain replay (not told).
+    std::ofstream(options.out / fmt::format("run-{}-rig.yaml", spec.id))
+        << sim::rig_file_text(spec.scenario.rig);
   }
   const auto replay =
       pipeline::replay_capture(capture, rig_evaluation_config(capture, spec, options));
@@ -156,8 +251,10 @@ RigScore score_rig_candidate(const std::vector<RigRunResult>& results, std::size
   RigScore score;
   score.per_size.resize(options.leak_sizes.size());
   for (const auto& r : results) {
-    add_run(score.all, r.run, candidate, 0, options.detect_within, true, true);
-    const double size = paper_equivalent_leak(r.run.spec);
+    // A seal that wears is scored by the size it is found at (the wear table), not in a window.
+    const bool opens = !r.run.spec.wear_run();
+    add_run(score.all, r.run, candidate, 0, options.detect_within, true, opens);
+    const double size = opens ? paper_equivalent_leak(r.run.spec) : 0.0;
     for (std::size_t k = 0; k < options.leak_sizes.size(); ++k) {
       if (size > 0.0 && size == options.leak_sizes[k]) {
         add_run(score.per_size[k], r.run, candidate, 0, options.detect_within, false, true);
@@ -172,10 +269,10 @@ RigScore score_rig_candidate(const std::vector<RigRunResult>& results, std::size
       score.out_of_band_blind += blind ? 1 : 0;
     }
     if (!blind) {
-      add_run(score.not_blind, r.run, candidate, 0, options.detect_within, false, true);
+      add_run(score.not_blind, r.run, candidate, 0, options.detect_within, false, opens);
     }
     if (r.rest_load >= kSeeableRestLoad) {
-      add_run(score.loaded, r.run, candidate, 0, options.detect_within, false, true);
+      add_run(score.loaded, r.run, candidate, 0, options.detect_within, false, opens);
     }
     score.sensor_fault_runs += r.any_fault[candidate] ? 1 : 0;
   }
@@ -234,6 +331,8 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
              r.run.spec.leak > 0.0 ? fmt::format("{:.3g}", r.run.spec.leak) : std::string("-"));
   }
 
+  write_rig_condition_tables(md, dir, options, results);
+
   auto tsv = fmt::output_file((dir / "rigs.tsv").string());
   tsv.print(
       "channels\ttold\thealthy_hours\tfalse_alarms\tfalse_alarms_per_hour_upper_95\tleak_runs\t"
@@ -252,7 +351,7 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
   auto runs = fmt::output_file((dir / "rigs_runs.tsv").string());
   runs.print(
       "run\tcontroller\tbore\trod\tstroke\tsupply\tKv\tmass\tspring\trest_load\tmode_hz\tleak\t"
-      "paper_equivalent_leak\tonset\tsensor_fault");
+      "paper_equivalent_leak\tonset\tsensor_fault\tprogram");
   for (std::size_t c = 0; c < all.size(); ++c) {
     runs.print("\tr{}_{}_{}_delay\tr{}_size\tr{}_blind", c, all[c].label,
                all[c].told ? "told" : "not_told", c, c);
@@ -264,9 +363,16 @@ void write_rig_summaries(const std::filesystem::path& dir, const EvaluationOptio
     runs.print("{}\t{}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.5g}\t{:.4g}\t{:.4g}\t",
                spec.id, sim::to_string(spec.scenario.controller), p.D, p.d, p.L, p.ps, p.Kv, p.m,
                p.K_s, r.rest_load, r.mode_hz);
-    runs.print("{:.4g}\t{:.4g}\t{}\t{}", spec.leak, paper_equivalent_leak(spec),
-               spec.leak > 0.0 ? fmt::format("{:.3f}", spec.onset) : std::string(""),
-               r.first_fault);
+    // The program's phases where they start ("hold 0.01 @0; sine 0.5 0.02 @212.4; ..."), or
+    // empty for the rig's steps.
+    std::string program;
+    for (const ProgramPhase& phase : spec.phases) {
+      program +=
+          fmt::format("{}{} @{:.1f}", program.empty() ? "" : "; ", phase.notation, phase.start);
+    }
+    runs.print("{:.4g}\t{:.4g}\t{}\t{}\t{}", spec.leak, paper_equivalent_leak(spec),
+               spec.leak > 0.0 ? fmt::format("{:.3f}", spec.onset) : std::string(""), r.first_fault,
+               program);
     for (std::size_t c = 0; c < all.size(); ++c) {
       // The first raise: its delay after the onset (negative: before it, a false alarm).
       const auto& alarms = r.run.alarms[c][0];

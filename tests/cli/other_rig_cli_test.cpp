@@ -157,7 +157,36 @@ TEST(EvaluateRigs, ASmallOtherRigsEvaluation) {
   EXPECT_NE(md.find("| p1,p2,u,x | not told |"), std::string::npos) << md;
 
   EXPECT_EQ(run_leakmon("evaluate --rigs moon --out " + dir, dir), 2);
-  EXPECT_EQ(run_leakmon("evaluate --rigs other --conditions warmup --out " + dir, dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --rigs other --conditions restart --out " + dir, dir), 2);
+  EXPECT_EQ(run_leakmon("evaluate --rigs other --sensor-fault-runs 2 --out " + dir, dir), 2);
+}
+
+// Other rigs running test programs and seals that wear: rigs.md gets the tables per phase kind
+// and per growth rate for every candidate, and rigs_programs.tsv / rigs_wear.tsv their rows.
+TEST(EvaluateRigs, ProgramsAndWearOnOtherRigsHaveTheirTables) {
+  const std::string dir = test::scratch_dir("evaluate_rigs_programs_cli");
+  ASSERT_EQ(run_leakmon("evaluate --rigs other --conditions programs,wear --out " + dir +
+                            " --healthy-runs 2 --runs-per-leak 2 --leaks 1e-12 --time-scale 0.1"
+                            " --learn-seconds 40 --after-onset 60 --seed 9",
+                        dir),
+            0)
+      << read(dir + "/leakmon.log");
+  const std::string md = read(dir + "/rigs.md");
+  EXPECT_NE(md.find("Test programs per phase kind"), std::string::npos) << md;
+  EXPECT_NE(md.find("Seals that wear"), std::string::npos) << md;
+  const std::vector<Row> phases = read_tsv(dir + "/rigs_programs.tsv");
+  ASSERT_FALSE(phases.empty());
+  double healthy_hours = 0.0;
+  for (const Row& r : phases) {
+    if (r.at("channels") == "p1,p2,u,x" && r.at("told") == "1") {
+      healthy_hours += std::stod(r.at("healthy_hours"));
+    }
+  }
+  EXPECT_GT(healthy_hours, 0.0);
+  const std::vector<Row> wear = read_tsv(dir + "/rigs_wear.tsv");
+  ASSERT_EQ(wear.size(), 6u * 4u);  // every candidate, all and the three growth rates
+  EXPECT_EQ(wear.front().at("growth"), "all");
+  EXPECT_EQ(wear.front().at("runs"), "1");
 }
 
 }  // namespace

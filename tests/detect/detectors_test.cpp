@@ -105,16 +105,17 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
                       "drift_window_seconds", "supply_settle_seconds", "min_excitation_range",
                       "max_excitation_wait_seconds", "regime_tolerance"})},
       {"flow_law",
-       with_learning(
-           {"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
-            "piston_area", "spool_time_constant", "learn_spool_time_constant", "min_lag_share",
-            "learn_null_offset", "learn_before_change", "min_load_spread",
-            // issue 23: learning waits for rest loads or identifying motion
-            "min_rest_loads", "rest_load_tolerance", "min_motion_load_share", "min_load",
-            "design_leak", "false_alarms_per_hour", "block_seconds", "sizing_seconds", "min_leak",
-            "max_leverage_ratio", "range_extension_seconds", "rest_speed", "supply_rest_seconds",
-            "judged_memory_seconds", "drift_guard_seconds", "drift_window_seconds",
-            "estimate_supply", "oil_grade", "oil_viscosity_40", "oil_viscosity_100"})}};
+       with_learning({"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
+                      "piston_area", "spool_time_constant", "learn_spool_time_constant",
+                      "min_lag_share", "learn_null_offset", "learn_before_change",
+                      "min_load_spread",
+                      // issue 23: learning waits for rest loads or identifying motion
+                      "min_rest_loads", "rest_load_tolerance", "min_motion_load_share", "min_load",
+                      "design_leak", "false_alarms_per_hour", "block_seconds", "sizing_seconds",
+                      "min_leak", "max_leverage_ratio", "range_extension_seconds", "rest_speed",
+                      "supply_rest_seconds", "supply_motion_seconds", "judged_memory_seconds",
+                      "drift_guard_seconds", "drift_window_seconds", "estimate_supply", "oil_grade",
+                      "oil_viscosity_40", "oil_viscosity_100"})}};
   std::vector<std::string> kinds = {"default"};
   for (const auto& kind : detector_registry()) {
     kinds.emplace_back(kind.name);

@@ -886,6 +886,7 @@ TEST(FlowLaw, AHuntingRigsTurningPointsAreNoSupplyReading) {
   options.min_rest_loads = 0.0;
   FlowLawOptions every_still_hop = options;
   every_still_hop.supply_rest_seconds = 0.0;
+  every_still_hop.supply_motion_seconds = 0.0;  // that build read no supply in motion either
   FlowLawDetector before = make(every_still_hop);
   const Outcome b = run(before, capture, 0.0);
   FlowLawDetector settled = make(options);
@@ -895,6 +896,39 @@ TEST(FlowLaw, AHuntingRigsTurningPointsAreNoSupplyReading) {
   EXPECT_GT(b.first_raise, 0.0);  // the test's rig is the one that raised
   EXPECT_GT(a.learned_at, 0.0);
   EXPECT_LT(a.max_score, settled.raise_threshold());
+}
+
+// Layout 6 read the supply at settled rests only: a state it wrote loads reading it so and
+// decides as that build did, here on a 14 MPa rig (stated 17.2) running a sine that never rests.
+TEST(FlowLaw, LayoutSixReadsTheSupplyAtRestOnlyAsItsBuildDid) {
+  sim::Scenario s = program(23, {sine(0.0, 0.7, 0.02)}, 200.0);
+  s.params.ps = 14e6;
+  const capture::Capture capture = sim::simulate(s);
+  FlowLawOptions at_rest_only;
+  at_rest_only.supply_motion_seconds = 0.0;
+  for (const double cut_seconds : {30.0, 150.0}) {  // learning, judging
+    FlowLawDetector old_build = make(at_rest_only);
+    const std::size_t split = static_cast<std::size_t>(cut_seconds * 500.0) + 3 * kStep;
+    run(old_build, capture, 1e9, 0, split);
+    const DetectorState current = old_build.export_state();
+    DetectorState layout_six("flow_law", 6);
+    for (const auto& [key, values] : current.entries()) {
+      if (key.rfind("supply_motion.", 0) == 0) continue;  // added in layout 7
+      layout_six.put(key, values);
+    }
+    FlowLawDetector updated = make();
+    updated.import_state(layout_six);
+    const Outcome a = run(old_build, capture, 1e9, split);
+    const Outcome b = run(updated, capture, 1e9, split);
+    EXPECT_EQ(a.last.score, b.last.score);
+    EXPECT_EQ(a.max_score, b.max_score);
+    EXPECT_EQ(old_build.supply(), updated.supply());
+    EXPECT_DOUBLE_EQ(updated.supply(), 17.2e6);  // never read: the stated supply
+  }
+  // A detector of this build reads it in the sine.
+  FlowLawDetector now = make();
+  run(now, capture, 1e9);
+  EXPECT_NEAR(now.supply(), 14e6, 0.02 * 14e6);
 }
 
 // The old build's layout (1: the stated lag only) loads with the stated lag chosen and decides
