@@ -232,6 +232,33 @@ DetectorState flow_law_from_6(const DetectorState& old) {
   return out;
 }
 
+// flow_law 7 had no tank-offset regressor (the stated tank pressure's error). As layout 4's null
+// offset: a state that had learned judges as it did (coefficient 0, the column left out: its
+// learned range gains an axis of its own, decoupled, that no block reaches); one still learning
+// keeps its blocks and learns without it until the next reset; one with no learning block yet
+// fits it, its block in progress not used.
+DetectorState flow_law_from_7(const DetectorState& old) {
+  DetectorState out(old.kind(), 8);
+  for (const auto& entry : old.entries()) out.put(entry.first, entry.second);
+  const std::size_t blocks = old.get_list("learned.t").size();
+  const bool learned = old.get("learning.learned") != 0.0;
+  out.put("learned.tank_offset", std::vector<double>(blocks, 0.0));
+  out.put("coefficient.tank_offset", 0.0);
+  out.put("tank_offset.fit", blocks > 0 || learned ? 0.0 : 1.0);
+  out.put("sample.tank_offset_gain", 0.0);
+  out.put("block.tank_offset", 0.0);
+  if (!learned && blocks == 0) out.put("block.ok", 0.0);
+  const auto& inverse = old.get_list("range.inverse_normal");
+  if (inverse.size() != 36) throw StateError("'range.inverse_normal' has the wrong length");
+  std::vector<double> padded(49, 0.0);
+  for (std::size_t column = 0; column < 6; ++column) {
+    for (std::size_t row = 0; row < 6; ++row) padded[column * 7 + row] = inverse[column * 6 + row];
+  }
+  padded[48] = 1.0;
+  out.put("range.inverse_normal", padded);
+  return out;
+}
+
 // One chamber's supply tracker: 17 values by position, then its holds' ring.
 void chamber_supply_from_positions(Conversion& c, const std::vector<double>& v,
                                    std::string_view prefix) {
@@ -495,6 +522,9 @@ DetectorState upgraded_state(const DetectorState& state, std::string_view kind, 
       return feature_test_from_rest_share(state, 4, "test");
     }
     if (kind == "paper" && state.version() == 1 && version == 2) return paper_from_1(state);
+    if (kind == "flow_law" && state.version() < 8 && version == 8) {
+      return flow_law_from_7(upgraded_state(state, kind, 7));
+    }
     if (kind == "flow_law" && state.version() < 7 && version == 7) {
       return flow_law_from_6(upgraded_state(state, kind, 6));
     }

@@ -107,8 +107,8 @@ TEST(DetectorRegistry, EachKindAcceptsItsTableKeys) {
       {"flow_law",
        with_learning({"supply_pressure", "tank_pressure", "command_full_scale", "valve_coefficient",
                       "piston_area", "spool_time_constant", "learn_spool_time_constant",
-                      "min_lag_share", "learn_null_offset", "learn_before_change",
-                      "min_load_spread",
+                      "min_lag_share", "learn_null_offset", "learn_tank_pressure",
+                      "learn_before_change", "min_load_spread",
                       // issue 23: learning waits for rest loads or identifying motion
                       "min_rest_loads", "rest_load_tolerance", "min_motion_load_share", "min_load",
                       "design_leak", "false_alarms_per_hour", "block_seconds", "sizing_seconds",
