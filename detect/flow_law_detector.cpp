@@ -615,6 +615,13 @@ double FlowLawDetector::tank_load_share(std::span<const Block> blocks) {
   return without_load > 0.0 ? unexplained(true) / without_load : kMissing;
 }
 
+// The model without the tank offset: its column zeroed in the blocks still to be fitted, so the
+// fit is the six-regressor model's to the bit.
+void FlowLawDetector::drop_tank_offset() {
+  fit_tank_offset_ = false;
+  for (auto& b : learned_) b.tank_offset = 0.0;
+}
+
 double FlowLawDetector::spool_time_constant() const {
   return tau_index_ == kTauNotChosen ? kMissing : taus_[tau_index_];
 }
@@ -625,17 +632,8 @@ void FlowLawDetector::finish_learning() {
   // a fast sine, whose lag and load were not told apart (the stated lag kept), left the lag's
   // error to the tank offset's term there, and the steps after it raised 43 times in 20 min on
   // a rig not described (run 23 of seed 2611; 7 without the term).
-  if (fit_tank_offset_ && options_.learn_spool_time_constant && !fit_lag_) {
-    fit_tank_offset_ = false;
-    for (auto& b : learned_) b.tank_offset = 0.0;
-  }
-  if (fit_tank_offset_) {
-    const double share = tank_load_share(learned_);
-    if (share < kMinTankShare) {
-      fit_tank_offset_ = false;
-      for (auto& b : learned_) b.tank_offset = 0.0;
-    }
-  }
+  if (fit_tank_offset_ && options_.learn_spool_time_constant && !fit_lag_) drop_tank_offset();
+  if (fit_tank_offset_ && tank_load_share(learned_) < kMinTankShare) drop_tank_offset();
   probe_learned_change();
   // A leak that opened while learning, after a reference that identifies the model: the blocks
   // before it are a healthy rig's, so the model is learned on them and the blocks after it are
@@ -656,8 +654,7 @@ void FlowLawDetector::finish_learning() {
   }
   fit_healthy(healthy);
   if (fit_tank_offset_ && !tank_offset_told(healthy)) {
-    fit_tank_offset_ = false;
-    for (auto& b : learned_) b.tank_offset = 0.0;
+    drop_tank_offset();
     drift_.clear();
     fit_healthy(healthy);
   }

@@ -276,6 +276,7 @@ class FlowLawDetector final : public Detector {
   static double lag_load_share(std::span<const Block> blocks);
   static double tank_load_share(std::span<const Block> blocks);
   bool tank_offset_told(std::span<const Block> blocks) const;
+  void drop_tank_offset();
   void restart_block();
   void add_sample(double u, double x, double p1, double p2);
   void close_block(double t, bool past_settling);

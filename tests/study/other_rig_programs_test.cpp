@@ -105,7 +105,14 @@ std::vector<RunSpec> programs_on_other_rigs(int healthy_runs) {
   return draw_runs(options);
 }
 
-int raised(const pipeline::ReplayResult& replay) {
+// The raises of the default replay of the capture, its detector given these options (YAML).
+int raised_with(const capture::Capture& capture, const std::string& detector_options) {
+  pipeline::DaemonConfig config = pipeline::default_replay_config(capture);
+  if (!detector_options.empty()) {
+    config.actuators.at(0).detector_options =
+        config::ConfigNode::load_string(detector_options, "test");
+  }
+  const pipeline::ReplayResult replay = pipeline::replay_capture(capture, config);
   return static_cast<int>(
       std::count_if(replay.events.begin(), replay.events.end(),
                     [](const auto& e) { return e.kind == io::EventKind::alarm_raised; }));
@@ -121,12 +128,8 @@ TEST(EvaluationRun, ARigNotDescribedThatNeverRestsIsJudgedAtItsOwnSupply) {
   const RunSpec& run = runs.at(13);
   ASSERT_NEAR(run.scenario.params.ps, 13.2911e6, 1e3);  // the evaluation's draw
   const capture::Capture capture = sim::simulate(run.scenario);
-  pipeline::DaemonConfig now = pipeline::default_replay_config(capture);
-  pipeline::DaemonConfig rests_only = now;
-  rests_only.actuators.at(0).detector_options =
-      config::ConfigNode::load_string("supply_motion_seconds: 0\n", "test");
-  const int before = raised(pipeline::replay_capture(capture, rests_only));
-  const int after = raised(pipeline::replay_capture(capture, now));
+  const int before = raised_with(capture, "supply_motion_seconds: 0\n");
+  const int after = raised_with(capture, "");
   std::printf("raised with the supply read at rest only: %d; read in motion too: %d\n", before,
               after);
   EXPECT_GT(before, 0);
@@ -144,12 +147,8 @@ TEST(EvaluationRun, ARigNotDescribedWithItsTankAboveTheStatedLearnsItsTankPressu
   const RunSpec& run = runs.at(2);
   ASSERT_NEAR(run.scenario.params.pt, 0.757244e6, 1e3);  // the evaluation's draw
   const capture::Capture capture = sim::simulate(run.scenario);
-  pipeline::DaemonConfig now = pipeline::default_replay_config(capture);
-  pipeline::DaemonConfig stated_tank = now;
-  stated_tank.actuators.at(0).detector_options =
-      config::ConfigNode::load_string("learn_tank_pressure: false\n", "test");
-  const int before = raised(pipeline::replay_capture(capture, stated_tank));
-  const int after = raised(pipeline::replay_capture(capture, now));
+  const int before = raised_with(capture, "learn_tank_pressure: false\n");
+  const int after = raised_with(capture, "");
   std::printf("raised with the stated tank pressure: %d; with its error learned: %d\n", before,
               after);
   EXPECT_GE(before, 10);
